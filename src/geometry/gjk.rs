@@ -1,0 +1,255 @@
+//! The Gilbert–Johnson–Keerthi distance algorithm on convex support maps.
+//!
+//! Works on the Minkowski difference `A − B` with B posed in A's frame; answers
+//! whether the shapes intersect and, when apart, their distance and closest points
+//! (in A's frame). The simplex is reduced with Voronoi-region tests on segments,
+//! triangles and tetrahedra (Ericson, *Real-Time Collision Detection*, ch. 5 and 9).
+
+use nalgebra::{Point3, Vector3};
+
+use super::{ConvexPolyhedron, Pose};
+use crate::Real;
+
+/// A convex shape known through its support function, in its own frame.
+pub trait SupportMap {
+    /// A point of the shape farthest along `dir`. `hint` carries a feature index
+    /// between calls so that large meshes can climb from the previous answer.
+    fn support(&self, dir: &Vector3<Real>, hint: &mut usize) -> Point3<Real>;
+}
+
+impl SupportMap for ConvexPolyhedron {
+    #[inline]
+    fn support(&self, dir: &Vector3<Real>, hint: &mut usize) -> Point3<Real> {
+        *hint = self.support_index(dir, *hint);
+        self.vertices()[*hint]
+    }
+}
+
+/// A single point (the core of a sphere).
+#[derive(Clone, Copy, Debug)]
+pub struct PointShape(pub Point3<Real>);
+
+impl SupportMap for PointShape {
+    #[inline]
+    fn support(&self, _dir: &Vector3<Real>, _hint: &mut usize) -> Point3<Real> {
+        self.0
+    }
+}
+
+/// Outcome of [`gjk`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum GjkResult {
+    /// The shapes share at least one point (to round-off).
+    Intersecting,
+    /// The shapes are apart.
+    Separated {
+        /// Distance between them.
+        distance: Real,
+        /// Closest point on A (A's frame).
+        point_a: Point3<Real>,
+        /// Closest point on B (A's frame).
+        point_b: Point3<Real>,
+    },
+}
+
+impl GjkResult {
+    /// Whether the shapes intersect.
+    pub fn intersects(&self) -> bool {
+        matches!(self, GjkResult::Intersecting)
+    }
+
+    /// Separation distance (zero when intersecting).
+    pub fn distance(&self) -> Real {
+        match self {
+            GjkResult::Intersecting => 0.0,
+            GjkResult::Separated { distance, .. } => *distance,
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug)]
+struct Vertex {
+    /// Point of the Minkowski difference `a − b`.
+    w: Vector3<Real>,
+    a: Point3<Real>,
+    b: Point3<Real>,
+}
+
+/// Runs GJK on A and B (B posed by `b_in_a`), starting from the search direction
+/// `guess` if given (a previous step's separating axis makes this converge in one or
+/// two iterations).
+pub fn gjk<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
+    a: &A,
+    b: &B,
+    b_in_a: &Pose,
+    guess: Option<Vector3<Real>>,
+) -> GjkResult {
+    const MAX_ITERATIONS: usize = 128;
+    const REL_TOLERANCE: Real = 1e-12;
+    let inv_rot = b_in_a.rotation.inverse();
+    let (mut hint_a, mut hint_b) = (0usize, 0usize);
+    let mut support = |d: &Vector3<Real>| {
+        // Support of A − B along d: s_A(d) − s_B(−d).
+        let pa = a.support(d, &mut hint_a);
+        let pb = b_in_a.transform_point(&b.support(&(inv_rot * -d), &mut hint_b));
+        Vertex {
+            w: pa - pb,
+            a: pa,
+            b: pb,
+        }
+    };
+    let mut v = guess
+        .filter(|g| g.norm_squared() > 0.0 && g.iter().all(|x| x.is_finite()))
+        .unwrap_or(-b_in_a.translation.vector);
+    if v.norm_squared() == 0.0 {
+        v = Vector3::x();
+    }
+    let first = support(&-v);
+    let mut simplex: Vec<Vertex> = vec![first];
+    let mut bary = vec![1.0];
+    v = first.w;
+    let mut max_w2 = first.w.norm_squared();
+    for _ in 0..MAX_ITERATIONS {
+        let v2 = v.norm_squared();
+        if v2 <= 1e-28 * max_w2.max(Real::MIN_POSITIVE) {
+            return GjkResult::Intersecting;
+        }
+        let w = support(&-v);
+        max_w2 = max_w2.max(w.w.norm_squared());
+        // Convergence: the support point brings v no closer.
+        if v2 - v.dot(&w.w) <= REL_TOLERANCE * v2 || simplex.iter().any(|s| s.w == w.w) {
+            return separated(&simplex, &bary, v2);
+        }
+        simplex.push(w);
+        let (closest, reduced) = closest_on_simplex(&simplex);
+        simplex = reduced.iter().map(|(i, _)| simplex[*i]).collect();
+        bary = reduced.iter().map(|(_, l)| *l).collect();
+        if simplex.len() == 4 {
+            return GjkResult::Intersecting;
+        }
+        if closest.norm_squared() >= v2 {
+            // No progress (round-off): v is as close as we get.
+            return separated(&simplex, &bary, v2);
+        }
+        v = closest;
+    }
+    separated(&simplex, &bary, v.norm_squared())
+}
+
+fn separated(simplex: &[Vertex], bary: &[Real], v2: Real) -> GjkResult {
+    let mut pa = Vector3::zeros();
+    let mut pb = Vector3::zeros();
+    for (s, l) in simplex.iter().zip(bary) {
+        pa += s.a.coords * *l;
+        pb += s.b.coords * *l;
+    }
+    GjkResult::Separated {
+        distance: v2.sqrt(),
+        point_a: Point3::from(pa),
+        point_b: Point3::from(pb),
+    }
+}
+
+/// The point of the simplex closest to the origin, and the sub-simplex (indices and
+/// barycentric weights) it lies on. A full tetrahedron returns itself when it holds
+/// the origin.
+fn closest_on_simplex(s: &[Vertex]) -> (Vector3<Real>, Vec<(usize, Real)>) {
+    match s.len() {
+        1 => (s[0].w, vec![(0, 1.0)]),
+        2 => closest_on_segment(s, 0, 1),
+        3 => closest_on_triangle(s, 0, 1, 2),
+        _ => closest_on_tetrahedron(s),
+    }
+}
+
+fn closest_on_segment(s: &[Vertex], i: usize, j: usize) -> (Vector3<Real>, Vec<(usize, Real)>) {
+    let (a, b) = (s[i].w, s[j].w);
+    let ab = b - a;
+    let t = -a.dot(&ab);
+    if t <= 0.0 {
+        return (a, vec![(i, 1.0)]);
+    }
+    let denom = ab.norm_squared();
+    if t >= denom {
+        return (b, vec![(j, 1.0)]);
+    }
+    let t = t / denom;
+    (a + ab * t, vec![(i, 1.0 - t), (j, t)])
+}
+
+fn closest_on_triangle(
+    s: &[Vertex],
+    i: usize,
+    j: usize,
+    k: usize,
+) -> (Vector3<Real>, Vec<(usize, Real)>) {
+    let (a, b, c) = (s[i].w, s[j].w, s[k].w);
+    let ab = b - a;
+    let ac = c - a;
+    let ap = -a;
+    let d1 = ab.dot(&ap);
+    let d2 = ac.dot(&ap);
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return (a, vec![(i, 1.0)]);
+    }
+    let bp = -b;
+    let d3 = ab.dot(&bp);
+    let d4 = ac.dot(&bp);
+    if d3 >= 0.0 && d4 <= d3 {
+        return (b, vec![(j, 1.0)]);
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        let v = d1 / (d1 - d3);
+        return (a + ab * v, vec![(i, 1.0 - v), (j, v)]);
+    }
+    let cp = -c;
+    let d5 = ab.dot(&cp);
+    let d6 = ac.dot(&cp);
+    if d6 >= 0.0 && d5 <= d6 {
+        return (c, vec![(k, 1.0)]);
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        let w = d2 / (d2 - d6);
+        return (a + ac * w, vec![(i, 1.0 - w), (k, w)]);
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+        let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        return (b + (c - b) * w, vec![(j, 1.0 - w), (k, w)]);
+    }
+    let denom = 1.0 / (va + vb + vc);
+    let v = vb * denom;
+    let w = vc * denom;
+    (a + ab * v + ac * w, vec![(i, 1.0 - v - w), (j, v), (k, w)])
+}
+
+fn closest_on_tetrahedron(s: &[Vertex]) -> (Vector3<Real>, Vec<(usize, Real)>) {
+    let faces = [(0, 1, 2, 3), (0, 1, 3, 2), (0, 2, 3, 1), (1, 2, 3, 0)];
+    let mut best: Option<(Vector3<Real>, Vec<(usize, Real)>)> = None;
+    let mut best_d2 = Real::INFINITY;
+    let mut inside = true;
+    for (i, j, k, l) in faces {
+        let (a, b, c, d) = (s[i].w, s[j].w, s[k].w, s[l].w);
+        let n = (b - a).cross(&(c - a));
+        let sign_origin = -n.dot(&a);
+        let sign_other = n.dot(&(d - a));
+        // Origin on the far side of this face from the fourth vertex (or on it for a
+        // flat tetrahedron): the closest point lies on this face.
+        if sign_origin * sign_other < 0.0 || sign_other == 0.0 {
+            inside = false;
+            let (p, sub) = closest_on_triangle(s, i, j, k);
+            let d2 = p.norm_squared();
+            if d2 < best_d2 {
+                best_d2 = d2;
+                best = Some((p, sub));
+            }
+        }
+    }
+    if inside {
+        let all = (0..4).map(|i| (i, 0.25)).collect();
+        return (Vector3::zeros(), all);
+    }
+    best.unwrap_or((s[0].w, vec![(0, 1.0)]))
+}

@@ -1,0 +1,45 @@
+//! Shapes and the pure geometric kernels between them.
+//!
+//! This layer knows nothing of time, forces or scenes. Every kernel takes shapes in
+//! their body frames and the pose of one relative to the other, and answers in the
+//! first shape's frame (as parry does), so that kernels stay small and testable and
+//! only callers convert to world coordinates.
+//!
+//! Contents:
+//! - [`ConvexPolyhedron`]: particle templates (merged polygon faces, outward planes,
+//!   exact mass properties, principal body frame);
+//! - [`generators`]: cuboids, Platonic solids, prism cylinders, icospheres, random
+//!   convex particles;
+//! - [`mesh_io`]: STL and OBJ loading with checks that name the offending facet;
+//! - [`gjk`]: intersection test and separation distance;
+//! - [`overlap`]: exact overlap volume, centroid and contact-area vector of two
+//!   convex polyhedra;
+//! - [`wall`]: polyhedron–triangle contact for wall meshes;
+//! - [`sphere`]: analytic sphere kernels.
+
+mod error;
+pub mod generators;
+pub mod gjk;
+mod hull;
+mod mass;
+pub mod mesh_io;
+pub mod overlap;
+mod plane;
+mod polygon;
+mod polyhedron;
+mod shape;
+pub mod sphere;
+mod trimesh;
+pub mod wall;
+
+pub use error::GeometryError;
+pub use hull::convex_hull;
+pub use mass::MassProperties;
+pub use plane::Plane;
+pub use polyhedron::ConvexPolyhedron;
+pub use shape::{Shape, Sphere};
+pub use trimesh::TriMesh;
+
+/// Pose of a body: rotation then translation, mapping body coordinates to the
+/// coordinates of the frame it lives in.
+pub type Pose = nalgebra::Isometry3<crate::Real>;

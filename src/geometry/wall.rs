@@ -1,0 +1,169 @@
+//! Contact between a convex polyhedron and one triangle of a wall mesh.
+//!
+//! # What a facet contributes
+//!
+//! A facet with unit normal `n` (pointing to the side particles live on) owns the
+//! half-infinite prism `Q` under it: the points behind its plane whose projection
+//! onto the plane falls inside the triangle. The facet's contact is the overlap
+//! `P ∩ Q` of the particle with that prism: its volume, its centroid, and the
+//! gradient of its volume with respect to the particle's translation. On a flat wall
+//! the prisms of the facets tile the half-space behind the wall, so the sums of
+//! these quantities over the touched facets are exactly those of the particle
+//! against the whole plane, however the plane is triangulated: the force on a
+//! particle pressed onto a flat wall does not depend on the mesh. (The side faces of
+//! neighbouring prisms cancel in the gradient; only at the boundary of a wall do they
+//! push a particle off its edge, as a potential must.)
+//!
+//! The overlap polygon of the facet with the particle's cross-section in the facet
+//! plane — the seed's Sutherland–Hodgman overlap area — comes out as the top face of
+//! `P ∩ Q`.
+//!
+//! The engine groups the facets a particle touches into coplanar patches and applies
+//! the contact law to each patch's sums, sharing the force among the facets in
+//! proportion to their volumes.
+
+use nalgebra::{Point3, Vector3};
+
+use super::polygon::{ConeSums, clip_by_plane, vector_area};
+use super::sphere::closest_point_on_triangle;
+use super::{ConvexPolyhedron, Plane};
+use crate::Real;
+
+/// The overlap of a particle with the prism under one wall facet, in the particle's
+/// body frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FacetOverlap {
+    /// Volume of the particle inside the facet's prism.
+    pub volume: Real,
+    /// Centroid of that volume.
+    pub centroid: Point3<Real>,
+    /// Gradient of `volume` with respect to the particle's translation; the elastic
+    /// force on the particle is `−U'(V) · volume_gradient` (it points out of the
+    /// wall).
+    pub volume_gradient: Vector3<Real>,
+    /// Deepest penetration of the particle behind the facet plane within the prism.
+    pub depth: Real,
+    /// Area of the overlap of the facet with the particle's cross-section in the facet
+    /// plane.
+    pub section_area: Real,
+    /// Unit facet normal (towards the particle side).
+    pub facet_normal: Vector3<Real>,
+}
+
+/// Overlap of `poly` with the prism under the triangle `tri` (given in the particle's
+/// body frame, counter-clockwise seen from the particle side). `None` if they do not
+/// overlap.
+pub fn polyhedron_triangle(
+    poly: &ConvexPolyhedron,
+    tri: &[Point3<Real>; 3],
+) -> Option<FacetOverlap> {
+    let (closest, _) = closest_point_on_triangle(tri, &Point3::origin());
+    if closest.coords.norm() >= poly.circumradius() {
+        return None;
+    }
+    let raw_normal = (tri[1] - tri[0]).cross(&(tri[2] - tri[0]));
+    let n = raw_normal.normalize();
+    if !n.iter().all(|x| x.is_finite()) {
+        return None;
+    }
+    let facet = Plane {
+        normal: n,
+        offset: n.dot(&tri[0].coords),
+    };
+    let deepest = poly.vertices()[poly.support_index(&-n, 0)];
+    let max_depth = -facet.distance(&deepest);
+    if max_depth <= 0.0 {
+        return None;
+    }
+    let mut planes = [facet; 4];
+    for k in 0..3 {
+        let e = tri[(k + 1) % 3] - tri[k];
+        let m = e.cross(&n).normalize();
+        planes[k + 1] = Plane {
+            normal: m,
+            offset: m.dot(&tri[k].coords),
+        };
+    }
+
+    let mut points: Vec<Point3<Real>> = Vec::with_capacity(64);
+    let mut starts: Vec<usize> = vec![0];
+    let mut poly_buf = Vec::with_capacity(16);
+    let mut tmp = Vec::with_capacity(16);
+    let mut dist = Vec::with_capacity(16);
+
+    // Faces of the particle clipped to the prism.
+    let mut grad_p = Vector3::zeros();
+    for f in 0..poly.face_count() {
+        poly_buf.clear();
+        poly_buf.extend(poly.face(f).iter().map(|&v| poly.vertices()[v as usize]));
+        for plane in &planes {
+            clip_by_plane(&mut poly_buf, plane, &mut dist, &mut tmp);
+            if poly_buf.len() < 3 {
+                break;
+            }
+        }
+        if poly_buf.len() >= 3 {
+            grad_p += vector_area(&poly_buf);
+            points.extend_from_slice(&poly_buf);
+            starts.push(points.len());
+        }
+    }
+    if points.is_empty() {
+        return None;
+    }
+
+    // Faces of the prism clipped to the particle: the facet itself, then the three
+    // sides, deep enough to reach below the particle.
+    let reach = max_depth * (1.0 + 1e-6) + 1e-9 * poly.circumradius();
+    let mut section_area = 0.0;
+    let mut grad_q = Vector3::zeros();
+    for side in 0..4 {
+        poly_buf.clear();
+        if side == 0 {
+            poly_buf.extend_from_slice(tri);
+        } else {
+            let (a, b) = (tri[side - 1], tri[side % 3]);
+            poly_buf.extend_from_slice(&[a, a - n * reach, b - n * reach, b]);
+        }
+        for plane in poly.planes() {
+            clip_by_plane(&mut poly_buf, plane, &mut dist, &mut tmp);
+            if poly_buf.len() < 3 {
+                break;
+            }
+        }
+        if poly_buf.len() >= 3 {
+            let s = vector_area(&poly_buf);
+            if side == 0 {
+                section_area = s.norm();
+            }
+            grad_q += s;
+            points.extend_from_slice(&poly_buf);
+            starts.push(points.len());
+        }
+    }
+
+    let origin = Point3::from(
+        points.iter().fold(Vector3::zeros(), |a, p| a + p.coords) / points.len() as Real,
+    );
+    let mut cone = ConeSums::new(origin);
+    for w in starts.windows(2) {
+        cone.add_polygon(&points[w[0]..w[1]]);
+    }
+    let volume = cone.volume();
+    if !(volume > 0.0) {
+        return None;
+    }
+    let depth = points
+        .iter()
+        .map(|p| -facet.distance(p))
+        .fold(0.0, Real::max);
+    Some(FacetOverlap {
+        volume,
+        centroid: cone.centroid(),
+        // ∂V/∂x_P = S_P = −S_Q; average the two for symmetry of round-off.
+        volume_gradient: 0.5 * (grad_p - grad_q),
+        depth,
+        section_area,
+        facet_normal: n,
+    })
+}

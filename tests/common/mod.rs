@@ -1,0 +1,62 @@
+//! Helpers shared by the integration tests.
+#![allow(dead_code)]
+
+use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
+use rand::{Rng, SeedableRng};
+use rand_pcg::Pcg64;
+use talus::geometry::ConvexPolyhedron;
+
+/// A pose from a translation and a rotation vector (axis times angle).
+pub fn pose(t: [f64; 3], rot: [f64; 3]) -> Isometry3<f64> {
+    Isometry3::from_parts(
+        Translation3::new(t[0], t[1], t[2]),
+        UnitQuaternion::from_scaled_axis(Vector3::from(rot)),
+    )
+}
+
+/// Whether `p` (body frame) lies inside the polyhedron.
+pub fn contains(poly: &ConvexPolyhedron, p: &Point3<f64>) -> bool {
+    poly.planes().iter().all(|pl| pl.distance(p) <= 0.0)
+}
+
+/// Monte Carlo estimate of the overlap volume of A and B (B posed in A's frame):
+/// (estimate, one standard error). Samples the box around A's bounding sphere.
+pub fn monte_carlo_overlap(
+    a: &ConvexPolyhedron,
+    b: &ConvexPolyhedron,
+    b_in_a: &Isometry3<f64>,
+    samples: usize,
+    seed: u64,
+) -> (f64, f64) {
+    let mut rng = Pcg64::seed_from_u64(seed);
+    let r = a.circumradius();
+    let inv = b_in_a.inverse();
+    let mut hits = 0usize;
+    for _ in 0..samples {
+        let p = Point3::new(
+            rng.random_range(-r..r),
+            rng.random_range(-r..r),
+            rng.random_range(-r..r),
+        );
+        if contains(a, &p) && contains(b, &inv.transform_point(&p)) {
+            hits += 1;
+        }
+    }
+    let box_volume = (2.0 * r).powi(3);
+    let p = hits as f64 / samples as f64;
+    (
+        box_volume * p,
+        box_volume * (p * (1.0 - p) / samples as f64).sqrt(),
+    )
+}
+
+/// Volume of the intersection of two axis-aligned boxes given by centre and size.
+pub fn box_overlap(c1: [f64; 3], s1: [f64; 3], c2: [f64; 3], s2: [f64; 3]) -> f64 {
+    (0..3)
+        .map(|k| {
+            let lo = (c1[k] - s1[k] / 2.0).max(c2[k] - s2[k] / 2.0);
+            let hi = (c1[k] + s1[k] / 2.0).min(c2[k] + s2[k] / 2.0);
+            (hi - lo).max(0.0)
+        })
+        .product()
+}
