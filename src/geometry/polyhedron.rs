@@ -9,8 +9,10 @@ use crate::Real;
 
 /// Two triangle normals closer than this (`1 - n1·n2`) belong to one polygon face.
 const COPLANAR_TOLERANCE: Real = 5e-12;
-/// Convexity tolerance relative to the circumscribed radius.
-const CONVEXITY_TOLERANCE: Real = 1e-7;
+/// Convexity tolerance relative to the mesh size: a dent smaller than this is
+/// round-off (STL stores single precision, 6e-8 relative, and extrapolating a small
+/// triangle's plane across a large face multiplies that error).
+const CONVEXITY_TOLERANCE: Real = 1e-6;
 /// Above this many vertices, support queries climb the vertex graph instead of
 /// scanning every vertex.
 const HILL_CLIMB_THRESHOLD: usize = 48;

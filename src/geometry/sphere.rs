@@ -84,7 +84,7 @@ pub fn sphere_polyhedron(
     }
     let (closest, normal, depth) = match gjk(
         poly,
-        &PointShape(*c),
+        &PointShape(Point3::origin()),
         &Pose::translation(c.x, c.y, c.z),
         None,
     ) {
