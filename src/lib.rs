@@ -10,6 +10,10 @@
 //! Higher layers (contact laws, world state, engine, scene files, co-simulation and
 //! transports) build on it.
 
+// `!(x > 0.0)` is how talus rejects NaN along with non-positive values; clippy's
+// rewrite to `partial_cmp` would hide that intent.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 pub mod geometry;
 
 /// The scalar type used throughout talus.

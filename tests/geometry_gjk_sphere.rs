@@ -8,7 +8,9 @@ use proptest::prelude::*;
 use talus::geometry::generators;
 use talus::geometry::gjk::{GjkResult, PointShape, gjk};
 use talus::geometry::overlap::overlap;
-use talus::geometry::sphere::{TriangleFeature, cap_volume, sphere_polyhedron, sphere_sphere, sphere_triangle};
+use talus::geometry::sphere::{
+    TriangleFeature, cap_volume, sphere_polyhedron, sphere_sphere, sphere_triangle,
+};
 
 /// Distance from `p` to the axis-aligned box of half-sizes `h` centred at the origin.
 fn box_distance(p: &Point3<f64>, h: &Vector3<f64>) -> f64 {
@@ -73,7 +75,10 @@ fn cube_gap_and_warm_start() {
     for gap in [1.0, 1e-3, 1e-9] {
         let rel = pose([1.0 + gap, 0.2, -0.1], [0.0; 3]);
         let cold = gjk(&c, &c, &rel, None);
-        assert!((cold.distance() - gap).abs() < 1e-12 * (1.0 + gap), "{gap}: {cold:?}");
+        assert!(
+            (cold.distance() - gap).abs() < 1e-12 * (1.0 + gap),
+            "{gap}: {cold:?}"
+        );
         let warm = gjk(&c, &c, &rel, Some(Vector3::x()));
         assert!((warm.distance() - gap).abs() < 1e-12 * (1.0 + gap));
     }
@@ -87,8 +92,15 @@ fn gjk_on_20480_facets_climbs_the_vertex_graph() {
     let r = gjk(&s, &s, &pose([2.5, 0.3, 0.0], [0.0; 3]), None);
     let d = (2.5f64 * 2.5 + 0.09).sqrt();
     // Inscribed mesh: between the sphere distance and that of the inscribed spheres.
-    let r_in = s.planes().iter().map(|p| p.offset).fold(f64::INFINITY, f64::min);
-    assert!(r.distance() >= d - 2.0 && r.distance() <= d - 2.0 * r_in + 1e-12, "{r:?}");
+    let r_in = s
+        .planes()
+        .iter()
+        .map(|p| p.offset)
+        .fold(f64::INFINITY, f64::min);
+    assert!(
+        r.distance() >= d - 2.0 && r.distance() <= d - 2.0 * r_in + 1e-12,
+        "{r:?}"
+    );
 }
 
 #[test]
@@ -106,7 +118,9 @@ fn sphere_sphere_lens() {
     // Unequal radii: volume is the sum of the two caps.
     let c = sphere_sphere(1.0, 0.25, &Vector3::new(1.1, 0.0, 0.0)).unwrap();
     let x = (1.1f64 * 1.1 + 1.0 - 0.0625) / 2.2;
-    assert!((c.volume - (cap_volume(1.0, 1.0 - x) + cap_volume(0.25, 0.25 - (1.1 - x)))).abs() < 1e-15);
+    assert!(
+        (c.volume - (cap_volume(1.0, 1.0 - x) + cap_volume(0.25, 0.25 - (1.1 - x)))).abs() < 1e-15
+    );
     assert!(sphere_sphere(0.5, 0.5, &Vector3::new(1.0, 0.0, 0.0)).is_none());
     let inside = sphere_sphere(1.0, 0.1, &Vector3::zeros()).unwrap();
     assert!(inside.volume.is_finite() && inside.normal.norm() == 1.0);
@@ -133,7 +147,11 @@ fn sphere_against_polyhedron() {
 
 #[test]
 fn sphere_against_triangle_features() {
-    let t = [Point3::new(0.0, 0.0, 0.0), Point3::new(1.0, 0.0, 0.0), Point3::new(0.0, 1.0, 0.0)];
+    let t = [
+        Point3::new(0.0, 0.0, 0.0),
+        Point3::new(1.0, 0.0, 0.0),
+        Point3::new(0.0, 1.0, 0.0),
+    ];
     let (c, f) = sphere_triangle(&t, &Point3::new(0.2, 0.2, 0.1), 0.15).unwrap();
     assert_eq!(f, TriangleFeature::Face);
     assert!((c.depth - 0.05).abs() < 1e-15 && (c.normal - Vector3::z()).norm() < 1e-15);

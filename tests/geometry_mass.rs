@@ -112,7 +112,7 @@ fn platonic_solids_by_circumradius() {
         (Platonic::Tetrahedron, 4, 4, 8.0 / (9.0 * 3f64.sqrt())),
         (Platonic::Cube, 6, 8, 8.0 / (3.0 * 3f64.sqrt())),
         (Platonic::Octahedron, 8, 6, 4.0 / 3.0),
-        (Platonic::Icosahedron, 20, 12, 2.53615071012040952),
+        (Platonic::Icosahedron, 20, 12, 2.536_150_710_120_409_5),
     ];
     for (kind, faces, verts, volume) in cases {
         let p = generators::platonic(kind, r).unwrap();

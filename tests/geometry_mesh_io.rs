@@ -39,7 +39,7 @@ fn write(name: &str, text: &str) -> PathBuf {
     p
 }
 
-fn load(path: &PathBuf) -> Result<talus::geometry::ConvexPolyhedron, GeometryError> {
+fn load(path: &std::path::Path) -> Result<talus::geometry::ConvexPolyhedron, GeometryError> {
     load_particle(path, ParticleMeshOptions::default())
 }
 
@@ -49,14 +49,25 @@ fn obj_cube_loads() {
     assert!((p.volume() - 8.0).abs() < 1e-14);
     assert_eq!(p.face_count(), 6);
     // Scaled from mm to m.
-    let p = load_particle(&write("cube_mm.obj", CUBE_OBJ), ParticleMeshOptions { convex_hull: false, scale: 1e-3 }).unwrap();
+    let p = load_particle(
+        &write("cube_mm.obj", CUBE_OBJ),
+        ParticleMeshOptions {
+            convex_hull: false,
+            scale: 1e-3,
+        },
+    )
+    .unwrap();
     assert!((p.volume() - 8e-9).abs() < 1e-20);
 }
 
 #[test]
 fn binary_and_ascii_stl_load() {
     let d = generators::dodecahedron(0.01).unwrap();
-    let tris: Vec<[usize; 3]> = d.triangles().iter().map(|t| [t[0] as usize, t[1] as usize, t[2] as usize]).collect();
+    let tris: Vec<[usize; 3]> = d
+        .triangles()
+        .iter()
+        .map(|t| [t[0] as usize, t[1] as usize, t[2] as usize])
+        .collect();
     let path = temp("dodeca.stl");
     write_stl(&path, d.vertices(), &tris).unwrap();
     let back = load(&path).unwrap();
@@ -79,19 +90,38 @@ fn open_mesh_names_the_edge() {
     let text = CUBE_OBJ.replace("f 4 1 5 8\n", "");
     let err = load(&write("open.obj", &text)).unwrap_err();
     let msg = err.to_string();
-    assert!(matches!(&err, GeometryError::InFile { source, .. } if matches!(**source, GeometryError::OpenEdge { .. })), "{msg}");
-    assert!(msg.contains("open.obj") && msg.contains("not closed") && msg.contains("edge"), "{msg}");
+    assert!(
+        matches!(&err, GeometryError::InFile { source, .. } if matches!(**source, GeometryError::OpenEdge { .. })),
+        "{msg}"
+    );
+    assert!(
+        msg.contains("open.obj") && msg.contains("not closed") && msg.contains("edge"),
+        "{msg}"
+    );
 }
 
 #[test]
 fn non_convex_mesh_is_rejected_unless_the_hull_is_asked_for() {
     // Push the top face's centre down: a cube with a dent (top face as 4 triangles).
-    let text = CUBE_OBJ.replace("f 5 6 7 8\n", "v 0 0 0.5\nf 5 6 9\nf 6 7 9\nf 7 8 9\nf 8 5 9\n");
+    let text = CUBE_OBJ.replace(
+        "f 5 6 7 8\n",
+        "v 0 0 0.5\nf 5 6 9\nf 6 7 9\nf 7 8 9\nf 8 5 9\n",
+    );
     let path = write("dent.obj", &text);
     let err = load(&path).unwrap_err();
     let msg = err.to_string();
-    assert!(msg.contains("not convex") && msg.contains("vertex") && msg.contains("facet"), "{msg}");
-    let hull = load_particle(&path, ParticleMeshOptions { convex_hull: true, scale: 1.0 }).unwrap();
+    assert!(
+        msg.contains("not convex") && msg.contains("vertex") && msg.contains("facet"),
+        "{msg}"
+    );
+    let hull = load_particle(
+        &path,
+        ParticleMeshOptions {
+            convex_hull: true,
+            scale: 1.0,
+        },
+    )
+    .unwrap();
     assert!((hull.volume() - 8.0).abs() < 1e-12);
 }
 
@@ -123,7 +153,10 @@ fn inside_out_mesh_is_flipped() {
 fn non_finite_coordinates() {
     let text = CUBE_OBJ.replace("v 1 1 1\n", "v 1 NaN 1\n");
     let msg = load(&write("nan.obj", &text)).unwrap_err().to_string();
-    assert!(msg.contains("non-finite") && msg.contains("vertex 6"), "{msg}");
+    assert!(
+        msg.contains("non-finite") && msg.contains("vertex 6"),
+        "{msg}"
+    );
 }
 
 #[test]
@@ -138,12 +171,17 @@ fn duplicate_vertices() {
 fn zero_area_facet() {
     let text = CUBE_OBJ.to_string() + "f 1 2 2\n";
     let msg = load(&write("zero.obj", &text)).unwrap_err().to_string();
-    assert!(msg.contains("zero area") && msg.contains("facet 12"), "{msg}");
+    assert!(
+        msg.contains("zero area") && msg.contains("facet 12"),
+        "{msg}"
+    );
 }
 
 #[test]
 fn coplanar_points_are_degenerate() {
-    let pts: Vec<Point3<f64>> = (0..10).map(|k| Point3::new(k as f64, (k * k) as f64, 0.0)).collect();
+    let pts: Vec<Point3<f64>> = (0..10)
+        .map(|k| Point3::new(k as f64, (k * k) as f64, 0.0))
+        .collect();
     let err = talus::geometry::ConvexPolyhedron::from_hull(&pts).unwrap_err();
     assert!(err.to_string().contains("do not span a volume"), "{err}");
     let three: Vec<Point3<f64>> = pts[..3].to_vec();
@@ -152,15 +190,26 @@ fn coplanar_points_are_degenerate() {
 
 #[test]
 fn file_level_errors_name_the_line() {
-    let msg = read_mesh(&write("bad_index.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n")).unwrap_err().to_string();
+    let msg = read_mesh(&write(
+        "bad_index.obj",
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n",
+    ))
+    .unwrap_err()
+    .to_string();
     assert!(msg.contains("line 4") && msg.contains("index 7"), "{msg}");
-    let msg = read_mesh(&write("bad_coord.obj", "v 0 0 zero\n")).unwrap_err().to_string();
+    let msg = read_mesh(&write("bad_coord.obj", "v 0 0 zero\n"))
+        .unwrap_err()
+        .to_string();
     assert!(msg.contains("line 1"), "{msg}");
-    let msg = read_mesh(&write("garbage.stl", "this is not an stl")).unwrap_err().to_string();
+    let msg = read_mesh(&write("garbage.stl", "this is not an stl"))
+        .unwrap_err()
+        .to_string();
     assert!(msg.contains("garbage.stl"), "{msg}");
     let msg = read_mesh(&temp("missing.obj")).unwrap_err().to_string();
     assert!(msg.contains("missing.obj"), "{msg}");
-    let msg = read_mesh(&write("shape.ply", "ply")).unwrap_err().to_string();
+    let msg = read_mesh(&write("shape.ply", "ply"))
+        .unwrap_err()
+        .to_string();
     assert!(msg.contains("unknown mesh format"), "{msg}");
 }
 
@@ -169,6 +218,11 @@ fn non_manifold_edge() {
     // Two tetrahedra sharing one edge (0-1) with a third facet fan: three facets on it.
     let text = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nv 0 -1 0\nv 0 0 -1\n\
 f 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\nf 1 2 5\nf 1 6 2\nf 1 5 6\nf 2 6 5\n";
-    let msg = load(&write("nonmanifold.obj", text)).unwrap_err().to_string();
-    assert!(msg.contains("not a manifold") || msg.contains("inconsistent orientation"), "{msg}");
+    let msg = load(&write("nonmanifold.obj", text))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        msg.contains("not a manifold") || msg.contains("inconsistent orientation"),
+        "{msg}"
+    );
 }

@@ -34,7 +34,12 @@ fn plate(w: f64, n: usize, irregular: bool, seed: u64) -> Vec<[Point3<f64>; 3]> 
     let mut tris = Vec::new();
     for i in 0..n {
         for j in 0..n {
-            let (a, b, c, d) = (nodes[i][j], nodes[i + 1][j], nodes[i + 1][j + 1], nodes[i][j + 1]);
+            let (a, b, c, d) = (
+                nodes[i][j],
+                nodes[i + 1][j],
+                nodes[i + 1][j + 1],
+                nodes[i][j + 1],
+            );
             if irregular && (i + j) % 2 == 1 {
                 tris.push([a, b, d]);
                 tris.push([b, c, d]);
@@ -49,7 +54,11 @@ fn plate(w: f64, n: usize, irregular: bool, seed: u64) -> Vec<[Point3<f64>; 3]> 
 
 /// Summed contact of a particle at `pose` (world) with wall triangles (world):
 /// (volume, volume gradient, deepest penetration, section area).
-fn wall_contact(p: &ConvexPolyhedron, pose: &Isometry3<f64>, tris: &[[Point3<f64>; 3]]) -> (f64, Vector3<f64>, f64, f64) {
+fn wall_contact(
+    p: &ConvexPolyhedron,
+    pose: &Isometry3<f64>,
+    tris: &[[Point3<f64>; 3]],
+) -> (f64, Vector3<f64>, f64, f64) {
     let inv = pose.inverse();
     let mut v = 0.0;
     let mut grad = Vector3::zeros();
@@ -79,7 +88,11 @@ fn flat_wall_contact_is_independent_of_the_triangulation() {
             let s = k as f64 * 0.00137;
             let lowest = {
                 let q = pose([0.0; 3], tilt);
-                cuboid.vertices().iter().map(|v| (q * v).z).fold(f64::INFINITY, f64::min)
+                cuboid
+                    .vertices()
+                    .iter()
+                    .map(|v| (q * v).z)
+                    .fold(f64::INFINITY, f64::min)
             };
             pose([s, -0.7 * s, -lowest - 0.0012], tilt)
         })
@@ -95,14 +108,27 @@ fn flat_wall_contact_is_independent_of_the_triangulation() {
                 let tris = plate(w, n, irregular, 17);
                 let (v, grad, depth, section) = wall_contact(&cuboid, p, &tris);
                 let label = format!("lambda {lambda}, irregular {irregular}");
-                assert!((v - reference.volume).abs() < 1e-9 * reference.volume, "{label}: {v} vs {}", reference.volume);
+                assert!(
+                    (v - reference.volume).abs() < 1e-9 * reference.volume,
+                    "{label}: {v} vs {}",
+                    reference.volume
+                );
                 // The force direction (along the gradient, out of the wall) and the
                 // projected area match the slab's.
                 let dir = -grad.normalize();
                 assert!((dir - Vector3::z()).norm() < 1e-9, "{label}: {dir}");
-                assert!((grad.norm() - reference.area).abs() < 1e-9 * reference.area, "{label}");
-                assert!((depth - reference.depth).abs() < 1e-9 * reference.depth, "{label}");
-                assert!((section - reference.area).abs() < 1e-9 * reference.area, "{label}");
+                assert!(
+                    (grad.norm() - reference.area).abs() < 1e-9 * reference.area,
+                    "{label}"
+                );
+                assert!(
+                    (depth - reference.depth).abs() < 1e-9 * reference.depth,
+                    "{label}"
+                );
+                assert!(
+                    (section - reference.area).abs() < 1e-9 * reference.area,
+                    "{label}"
+                );
             }
         }
     }
@@ -134,9 +160,19 @@ fn single_facet_overlap_polygon_and_edge_push() {
     // whole cross-section; hanging over the triangle's edge, it is cut by the edge and
     // the prism's side pushes the particle off the edge.
     let cube = generators::cuboid(1.0, 1.0, 1.0).unwrap();
-    let tri = [Point3::new(-10.0, -10.0, 0.0), Point3::new(10.0, -10.0, 0.0), Point3::new(0.0, 10.0, 0.0)];
+    let tri = [
+        Point3::new(-10.0, -10.0, 0.0),
+        Point3::new(10.0, -10.0, 0.0),
+        Point3::new(0.0, 10.0, 0.0),
+    ];
     let inside = pose([0.0, 0.0, 0.4], [0.0; 3]);
-    let local = |p: &Isometry3<f64>| [p.inverse() * tri[0], p.inverse() * tri[1], p.inverse() * tri[2]];
+    let local = |p: &Isometry3<f64>| {
+        [
+            p.inverse() * tri[0],
+            p.inverse() * tri[1],
+            p.inverse() * tri[2],
+        ]
+    };
     let o = polyhedron_triangle(&cube, &local(&inside)).unwrap();
     assert!((o.volume - 0.1).abs() < 1e-14);
     assert!((o.section_area - 1.0).abs() < 1e-14);
@@ -149,7 +185,11 @@ fn single_facet_overlap_polygon_and_edge_push() {
     assert!((o.section_area - 0.5).abs() < 1e-14);
     // ∂V/∂x: −0.5 along z (pressing deeper adds volume over the half cross-section)
     // and +0.1 along y (moving off the edge, towards −y, loses the 0.1-high face).
-    assert!((o.volume_gradient - Vector3::new(0.0, 0.1, -0.5)).norm() < 1e-13, "{}", o.volume_gradient);
+    assert!(
+        (o.volume_gradient - Vector3::new(0.0, 0.1, -0.5)).norm() < 1e-13,
+        "{}",
+        o.volume_gradient
+    );
     // Apart: nothing.
     assert!(polyhedron_triangle(&cube, &local(&pose([0.0, 0.0, 0.5 + 1e-9], [0.0; 3]))).is_none());
     assert!(polyhedron_triangle(&cube, &local(&pose([0.0, -10.6, 0.4], [0.0; 3]))).is_none());

@@ -75,6 +75,28 @@ struct Vertex {
     b: Point3<Real>,
 }
 
+/// Barycentric weights on a sub-simplex: up to four (vertex index, weight) pairs.
+#[derive(Clone, Copy, Debug)]
+struct SubSimplex {
+    entries: [(usize, Real); 4],
+    len: usize,
+}
+
+impl SubSimplex {
+    fn of(entries: &[(usize, Real)]) -> Self {
+        let mut out = SubSimplex {
+            entries: [(0, 0.0); 4],
+            len: entries.len(),
+        };
+        out.entries[..entries.len()].copy_from_slice(entries);
+        out
+    }
+
+    fn iter(&self) -> impl Iterator<Item = &(usize, Real)> {
+        self.entries[..self.len].iter()
+    }
+}
+
 /// Runs GJK on A and B (B posed by `b_in_a`), starting from the search direction
 /// `guess` if given (a previous step's separating axis makes this converge in one or
 /// two iterations).
@@ -105,8 +127,9 @@ pub fn gjk<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
         v = Vector3::x();
     }
     let first = support(&-v);
-    let mut simplex: Vec<Vertex> = vec![first];
-    let mut bary = vec![1.0];
+    let mut simplex = [first; 4];
+    let mut count = 1;
+    let mut weights = SubSimplex::of(&[(0, 1.0)]);
     v = first.w;
     let mut max_w2 = first.w.norm_squared();
     for _ in 0..MAX_ITERATIONS {
@@ -117,31 +140,41 @@ pub fn gjk<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
         let w = support(&-v);
         max_w2 = max_w2.max(w.w.norm_squared());
         // Convergence: the support point brings v no closer.
-        if v2 - v.dot(&w.w) <= REL_TOLERANCE * v2 || simplex.iter().any(|s| s.w == w.w) {
-            return separated(&simplex, &bary, v2);
+        if v2 - v.dot(&w.w) <= REL_TOLERANCE * v2 || simplex[..count].iter().any(|s| s.w == w.w) {
+            return separated(&simplex, &weights, v2);
         }
-        simplex.push(w);
-        let (closest, reduced) = closest_on_simplex(&simplex);
-        simplex = reduced.iter().map(|(i, _)| simplex[*i]).collect();
-        bary = reduced.iter().map(|(_, l)| *l).collect();
-        if simplex.len() == 4 {
+        simplex[count] = w;
+        count += 1;
+        let (closest, sub) = closest_on_simplex(&simplex[..count]);
+        // Keep only the vertices of the sub-simplex, in order.
+        let mut reduced = simplex;
+        for (k, &(i, _)) in sub.iter().enumerate() {
+            reduced[k] = simplex[i];
+        }
+        simplex = reduced;
+        count = sub.len;
+        weights = sub;
+        for (k, e) in weights.entries[..count].iter_mut().enumerate() {
+            e.0 = k;
+        }
+        if count == 4 {
             return GjkResult::Intersecting;
         }
         if closest.norm_squared() >= v2 {
             // No progress (round-off): v is as close as we get.
-            return separated(&simplex, &bary, v2);
+            return separated(&simplex, &weights, v2);
         }
         v = closest;
     }
-    separated(&simplex, &bary, v.norm_squared())
+    separated(&simplex, &weights, v.norm_squared())
 }
 
-fn separated(simplex: &[Vertex], bary: &[Real], v2: Real) -> GjkResult {
+fn separated(simplex: &[Vertex], weights: &SubSimplex, v2: Real) -> GjkResult {
     let mut pa = Vector3::zeros();
     let mut pb = Vector3::zeros();
-    for (s, l) in simplex.iter().zip(bary) {
-        pa += s.a.coords * *l;
-        pb += s.b.coords * *l;
+    for &(i, l) in weights.iter() {
+        pa += simplex[i].a.coords * l;
+        pb += simplex[i].b.coords * l;
     }
     GjkResult::Separated {
         distance: v2.sqrt(),
@@ -153,36 +186,31 @@ fn separated(simplex: &[Vertex], bary: &[Real], v2: Real) -> GjkResult {
 /// The point of the simplex closest to the origin, and the sub-simplex (indices and
 /// barycentric weights) it lies on. A full tetrahedron returns itself when it holds
 /// the origin.
-fn closest_on_simplex(s: &[Vertex]) -> (Vector3<Real>, Vec<(usize, Real)>) {
+fn closest_on_simplex(s: &[Vertex]) -> (Vector3<Real>, SubSimplex) {
     match s.len() {
-        1 => (s[0].w, vec![(0, 1.0)]),
+        1 => (s[0].w, SubSimplex::of(&[(0, 1.0)])),
         2 => closest_on_segment(s, 0, 1),
         3 => closest_on_triangle(s, 0, 1, 2),
         _ => closest_on_tetrahedron(s),
     }
 }
 
-fn closest_on_segment(s: &[Vertex], i: usize, j: usize) -> (Vector3<Real>, Vec<(usize, Real)>) {
+fn closest_on_segment(s: &[Vertex], i: usize, j: usize) -> (Vector3<Real>, SubSimplex) {
     let (a, b) = (s[i].w, s[j].w);
     let ab = b - a;
     let t = -a.dot(&ab);
     if t <= 0.0 {
-        return (a, vec![(i, 1.0)]);
+        return (a, SubSimplex::of(&[(i, 1.0)]));
     }
     let denom = ab.norm_squared();
     if t >= denom {
-        return (b, vec![(j, 1.0)]);
+        return (b, SubSimplex::of(&[(j, 1.0)]));
     }
     let t = t / denom;
-    (a + ab * t, vec![(i, 1.0 - t), (j, t)])
+    (a + ab * t, SubSimplex::of(&[(i, 1.0 - t), (j, t)]))
 }
 
-fn closest_on_triangle(
-    s: &[Vertex],
-    i: usize,
-    j: usize,
-    k: usize,
-) -> (Vector3<Real>, Vec<(usize, Real)>) {
+fn closest_on_triangle(s: &[Vertex], i: usize, j: usize, k: usize) -> (Vector3<Real>, SubSimplex) {
     let (a, b, c) = (s[i].w, s[j].w, s[k].w);
     let ab = b - a;
     let ac = c - a;
@@ -190,44 +218,47 @@ fn closest_on_triangle(
     let d1 = ab.dot(&ap);
     let d2 = ac.dot(&ap);
     if d1 <= 0.0 && d2 <= 0.0 {
-        return (a, vec![(i, 1.0)]);
+        return (a, SubSimplex::of(&[(i, 1.0)]));
     }
     let bp = -b;
     let d3 = ab.dot(&bp);
     let d4 = ac.dot(&bp);
     if d3 >= 0.0 && d4 <= d3 {
-        return (b, vec![(j, 1.0)]);
+        return (b, SubSimplex::of(&[(j, 1.0)]));
     }
     let vc = d1 * d4 - d3 * d2;
     if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
         let v = d1 / (d1 - d3);
-        return (a + ab * v, vec![(i, 1.0 - v), (j, v)]);
+        return (a + ab * v, SubSimplex::of(&[(i, 1.0 - v), (j, v)]));
     }
     let cp = -c;
     let d5 = ab.dot(&cp);
     let d6 = ac.dot(&cp);
     if d6 >= 0.0 && d5 <= d6 {
-        return (c, vec![(k, 1.0)]);
+        return (c, SubSimplex::of(&[(k, 1.0)]));
     }
     let vb = d5 * d2 - d1 * d6;
     if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
         let w = d2 / (d2 - d6);
-        return (a + ac * w, vec![(i, 1.0 - w), (k, w)]);
+        return (a + ac * w, SubSimplex::of(&[(i, 1.0 - w), (k, w)]));
     }
     let va = d3 * d6 - d5 * d4;
     if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
         let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-        return (b + (c - b) * w, vec![(j, 1.0 - w), (k, w)]);
+        return (b + (c - b) * w, SubSimplex::of(&[(j, 1.0 - w), (k, w)]));
     }
     let denom = 1.0 / (va + vb + vc);
     let v = vb * denom;
     let w = vc * denom;
-    (a + ab * v + ac * w, vec![(i, 1.0 - v - w), (j, v), (k, w)])
+    (
+        a + ab * v + ac * w,
+        SubSimplex::of(&[(i, 1.0 - v - w), (j, v), (k, w)]),
+    )
 }
 
-fn closest_on_tetrahedron(s: &[Vertex]) -> (Vector3<Real>, Vec<(usize, Real)>) {
+fn closest_on_tetrahedron(s: &[Vertex]) -> (Vector3<Real>, SubSimplex) {
     let faces = [(0, 1, 2, 3), (0, 1, 3, 2), (0, 2, 3, 1), (1, 2, 3, 0)];
-    let mut best: Option<(Vector3<Real>, Vec<(usize, Real)>)> = None;
+    let mut best: Option<(Vector3<Real>, SubSimplex)> = None;
     let mut best_d2 = Real::INFINITY;
     let mut inside = true;
     for (i, j, k, l) in faces {
@@ -248,8 +279,10 @@ fn closest_on_tetrahedron(s: &[Vertex]) -> (Vector3<Real>, Vec<(usize, Real)>) {
         }
     }
     if inside {
-        let all = (0..4).map(|i| (i, 0.25)).collect();
-        return (Vector3::zeros(), all);
+        return (
+            Vector3::zeros(),
+            SubSimplex::of(&[(0, 0.25), (1, 0.25), (2, 0.25), (3, 0.25)]),
+        );
     }
-    best.unwrap_or((s[0].w, vec![(0, 1.0)]))
+    best.unwrap_or((s[0].w, SubSimplex::of(&[(0, 1.0)])))
 }

@@ -141,15 +141,13 @@ pub fn convex_hull(points: &[Point3<Real>]) -> Result<TriMesh, GeometryError> {
     let mut vertices = Vec::new();
     let mut triangles = Vec::new();
     for face in faces.iter().filter(|f| f.alive) {
-        let mut t = [0; 3];
-        for k in 0..3 {
-            let v = face.v[k];
+        let t = face.v.map(|v| {
             if remap[v] == usize::MAX {
                 remap[v] = vertices.len();
                 vertices.push(points[v]);
             }
-            t[k] = remap[v];
-        }
+            remap[v]
+        });
         triangles.push(t);
     }
     TriMesh::new(vertices, triangles)

@@ -28,6 +28,7 @@ mod plane;
 mod polygon;
 mod polyhedron;
 mod shape;
+mod spec;
 pub mod sphere;
 mod trimesh;
 pub mod wall;
@@ -38,6 +39,7 @@ pub use mass::MassProperties;
 pub use plane::Plane;
 pub use polyhedron::ConvexPolyhedron;
 pub use shape::{Shape, Sphere};
+pub use spec::ShapeSpec;
 pub use trimesh::TriMesh;
 
 /// Pose of a body: rotation then translation, mapping body coordinates to the

@@ -30,23 +30,29 @@
 //! subgradient with no component along their normal (flush neighbours in a lattice
 //! feel no sideways push).
 //!
-//! For large meshes (hundreds of faces) only faces whose bounding spheres meet the box
-//! `R` enclosing both bounding spheres take part, after clipping to `R`. This is exact
-//! when the shapes intersect (B ∩ R is bounded by the planes of the faces of B that
-//! meet R), which is checked with GJK first.
+//! Shapes of up to 64 faces (dodecahedra, prism pellets, most STL pellets) take a
+//! bit-mask path: for every vertex one bit per plane of the other shape says
+//! "outside"; the AND over a face's vertices rejects it, the OR lists the planes that
+//! cut it, and the AND over all vertices detects a separating face plane.
+//!
+//! For larger meshes (icospheres of hundreds to tens of thousands of facets) only faces
+//! whose bounding spheres meet the box `R` enclosing both bounding spheres take part,
+//! after clipping to `R`. This is exact when the shapes intersect (B ∩ R is bounded by
+//! the planes of the faces of B that meet R), which is checked with GJK first.
 
 use std::cell::RefCell;
 
 use nalgebra::{Point3, Vector3};
 
 use super::gjk::{self, GjkResult};
-use super::polygon::{ConeSums, clip_by_plane, clip_with_distances, vector_area};
+use super::polygon::{ConeSums, clip_by_plane, vector_area};
 use super::{ConvexPolyhedron, Plane, Pose};
 use crate::Real;
 
-/// Above this many faces in total, faces are culled against the region the overlap can
-/// occupy before clipping.
-const CULL_FACE_THRESHOLD: usize = 96;
+/// Shapes with at most this many faces each take the bit-mask path: one bit per
+/// plane and vertex says "outside", and whole faces are accepted, rejected or given
+/// their cutting planes by a few ANDs and ORs.
+const MASK_MAX_FACES: usize = 64;
 
 /// The overlap of two convex polyhedra, in the frame of the first.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -78,14 +84,20 @@ impl OverlapGeometry {
 pub struct OverlapScratch {
     b_points: Vec<Point3<Real>>,
     b_planes: Vec<Plane>,
+    soa: PlaneSoa,
+    /// Per face of A (B): the planes of B (A) it reaches.
+    reach_a: Vec<u64>,
+    reach_b: Vec<u64>,
+    /// Per vertex of A: bit g set when outside B's plane g (and "on" bits).
+    out_a: Vec<u64>,
+    on_a: Vec<u64>,
+    /// Per vertex of B: bit f set when outside A's plane f (and "on" bits).
+    out_b: Vec<u64>,
+    on_b: Vec<u64>,
     a_faces: Vec<u32>,
     b_faces: Vec<u32>,
-    a_plane_ids: Vec<u32>,
-    b_plane_ids: Vec<u32>,
-    /// Distances of A's vertices from B's candidate planes, one row per plane.
-    dist_a: Vec<Real>,
-    /// Distances of B's vertices from A's candidate planes, one row per plane.
-    dist_b: Vec<Real>,
+    /// Bounding spheres of B's faces in A's frame.
+    b_spheres: Vec<(Point3<Real>, Real)>,
     cutting: Vec<u32>,
     poly: Vec<Point3<Real>>,
     poly_tmp: Vec<Point3<Real>>,
@@ -116,103 +128,369 @@ pub fn overlap_with(
     s: &mut OverlapScratch,
 ) -> Option<OverlapGeometry> {
     let t = b_in_a.translation.vector;
-    let (ra, rb) = (a.circumradius(), b.circumradius());
-    if t.norm() >= ra + rb {
+    if t.norm() >= a.circumradius() + b.circumradius() {
         return None;
     }
-    let tol = 1e-12 * ra.max(rb);
-
     s.b_points.clear();
     s.b_points
         .extend(b.vertices().iter().map(|p| b_in_a.transform_point(p)));
     s.b_planes.clear();
     s.b_planes
         .extend(b.planes().iter().map(|p| p.transformed(b_in_a)));
-
-    // Region the overlap can occupy, for culling on large meshes.
-    let cull = a.face_count() + b.face_count() > CULL_FACE_THRESHOLD;
-    let mut region = None;
-    if cull {
-        if !matches!(gjk::gjk(a, b, b_in_a, None), GjkResult::Intersecting) {
-            return None;
-        }
-        let lo = (-Vector3::repeat(ra)).sup(&(t - Vector3::repeat(rb)));
-        let hi = Vector3::repeat(ra).inf(&(t + Vector3::repeat(rb)));
-        region = Some((lo, hi));
+    s.points.clear();
+    s.starts.clear();
+    s.starts.push(0);
+    if a.face_count() <= MASK_MAX_FACES && b.face_count() <= MASK_MAX_FACES {
+        overlap_masked(a, b, s)
+    } else {
+        overlap_culled(a, b, b_in_a, s)
     }
-    let touches_region = |c: &Point3<Real>, r: Real| match region {
-        None => true,
-        Some((lo, hi)) => {
-            let q = c.coords.sup(&lo).inf(&hi);
-            (c.coords - q).norm_squared() <= r * r
+}
+
+/// Coplanarity tolerance on plane distances.
+fn tolerance(a: &ConvexPolyhedron, b: &ConvexPolyhedron) -> Real {
+    1e-12 * a.circumradius().max(b.circumradius())
+}
+
+/// Planes in structure-of-arrays form, padded to a multiple of 4 so that the
+/// distance loop vectorises.
+#[derive(Default, Debug)]
+struct PlaneSoa {
+    nx: Vec<Real>,
+    ny: Vec<Real>,
+    nz: Vec<Real>,
+    offset: Vec<Real>,
+}
+
+impl PlaneSoa {
+    fn fill(&mut self, planes: &[Plane]) {
+        let n = planes.len().next_multiple_of(4);
+        for v in [&mut self.nx, &mut self.ny, &mut self.nz, &mut self.offset] {
+            v.clear();
         }
-    };
+        for p in planes {
+            self.nx.push(p.normal.x);
+            self.ny.push(p.normal.y);
+            self.nz.push(p.normal.z);
+            self.offset.push(p.offset);
+        }
+        // Padding planes never cut: every point is far inside them.
+        for v in [&mut self.nx, &mut self.ny, &mut self.nz] {
+            v.resize(n, 0.0);
+        }
+        self.offset.resize(n, Real::MAX);
+    }
+}
+
+/// Sets, per point, bit `k` of `out` when the point lies more than `tol` outside
+/// plane `k`, and of `on` when it lies within `tol` of it.
+fn plane_masks(
+    points: &[Point3<Real>],
+    planes: &PlaneSoa,
+    tol: Real,
+    out: &mut Vec<u64>,
+    on: &mut Vec<u64>,
+) {
+    out.clear();
+    on.clear();
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
+        // SAFETY: the CPU supports the features the function is compiled for.
+        unsafe { plane_masks_avx2(points, planes, tol, out, on) };
+        return;
+    }
+    plane_masks_scalar(points, planes, tol, out, on);
+}
+
+fn plane_masks_scalar(
+    points: &[Point3<Real>],
+    planes: &PlaneSoa,
+    tol: Real,
+    out: &mut Vec<u64>,
+    on: &mut Vec<u64>,
+) {
+    for p in points {
+        let (mut o, mut n) = (0u64, 0u64);
+        for k in 0..planes.nx.len() {
+            let d = planes.nx[k] * p.x + planes.ny[k] * p.y + planes.nz[k] * p.z - planes.offset[k];
+            o |= ((d > tol) as u64) << k;
+            n |= ((d.abs() <= tol) as u64) << k;
+        }
+        out.push(o);
+        on.push(n);
+    }
+}
+
+/// [`plane_masks_scalar`] four planes at a time, the masks read off the sign bits.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+unsafe fn plane_masks_avx2(
+    points: &[Point3<Real>],
+    planes: &PlaneSoa,
+    tol: Real,
+    out: &mut Vec<u64>,
+    on: &mut Vec<u64>,
+) {
+    use std::arch::x86_64::*;
+    let chunks = planes.nx.len() / 4;
+    let tol_v = _mm256_set1_pd(tol);
+    let neg_tol_v = _mm256_set1_pd(-tol);
+    for p in points {
+        let (px, py, pz) = (
+            _mm256_set1_pd(p.x),
+            _mm256_set1_pd(p.y),
+            _mm256_set1_pd(p.z),
+        );
+        let (mut o, mut n) = (0u64, 0u64);
+        for c in 0..chunks {
+            // SAFETY: each array holds 4 * chunks values.
+            let (nx, ny, nz, off) = unsafe {
+                (
+                    _mm256_loadu_pd(planes.nx.as_ptr().add(4 * c)),
+                    _mm256_loadu_pd(planes.ny.as_ptr().add(4 * c)),
+                    _mm256_loadu_pd(planes.nz.as_ptr().add(4 * c)),
+                    _mm256_loadu_pd(planes.offset.as_ptr().add(4 * c)),
+                )
+            };
+            let d = _mm256_fmadd_pd(
+                nz,
+                pz,
+                _mm256_fmadd_pd(ny, py, _mm256_fmsub_pd(nx, px, off)),
+            );
+            let outside = _mm256_movemask_pd(_mm256_cmp_pd::<_CMP_GT_OQ>(d, tol_v)) as u64;
+            let on_plane = _mm256_movemask_pd(_mm256_and_pd(
+                _mm256_cmp_pd::<_CMP_LE_OQ>(d, tol_v),
+                _mm256_cmp_pd::<_CMP_GE_OQ>(d, neg_tol_v),
+            )) as u64;
+            o |= outside << (4 * c);
+            n |= on_plane << (4 * c);
+        }
+        out.push(o);
+        on.push(n);
+    }
+}
+
+/// For every face of `shape`, the planes of the other shape (bits) that the face
+/// reaches: has vertices on both sides of, or on.
+fn faces_reaching_planes(shape: &ConvexPolyhedron, out: &[u64], on: &[u64], reach: &mut Vec<u64>) {
+    reach.clear();
+    for f in 0..shape.face_count() {
+        let (mut any_out, mut any_in, mut any_on) = (0u64, 0u64, 0u64);
+        for &v in shape.face(f) {
+            let (o, n) = (out[v as usize], on[v as usize]);
+            any_out |= o;
+            any_in |= !(o | n);
+            any_on |= n;
+        }
+        reach.push((any_out & any_in) | any_on);
+    }
+}
+
+/// Bit `k` of the result is bit `bit` of `rows[k]`.
+#[inline]
+fn transposed_bit(rows: &[u64], bit: usize) -> u64 {
+    rows.iter()
+        .enumerate()
+        .fold(0, |m, (k, &r)| m | ((r >> bit) & 1) << k)
+}
+
+/// Planes (bits) that the point set crosses (points strictly on both sides) or
+/// touches from inside (points on it, none outside): only faces in such planes can
+/// bound the intersection.
+fn live_planes(out: &[u64], on: &[u64]) -> u64 {
+    let (mut any_out, mut any_in, mut any_on) = (0u64, 0u64, 0u64);
+    for (&o, &n) in out.iter().zip(on) {
+        any_out |= o;
+        any_in |= !(o | n);
+        any_on |= n;
+    }
+    (any_out & any_in) | (any_on & !any_out)
+}
+
+/// The bit-mask path for shapes of at most 64 faces each.
+fn overlap_masked(
+    a: &ConvexPolyhedron,
+    b: &ConvexPolyhedron,
+    s: &mut OverlapScratch,
+) -> Option<OverlapGeometry> {
+    let tol = tolerance(a, b);
+    s.soa.fill(&s.b_planes);
+    plane_masks(a.vertices(), &s.soa, tol, &mut s.out_a, &mut s.on_a);
+    // A plane of B with every vertex of A outside separates them.
+    if s.out_a.iter().fold(u64::MAX, |m, &x| m & x) != 0 {
+        return None;
+    }
+    s.soa.fill(a.planes());
+    plane_masks(&s.b_points, &s.soa, tol, &mut s.out_b, &mut s.on_b);
+    if s.out_b.iter().fold(u64::MAX, |m, &x| m & x) != 0 {
+        return None;
+    }
+    // A face can only meet the other solid if that solid straddles its plane (or lies
+    // in it).
+    let live_a = live_planes(&s.out_b, &s.on_b);
+    let live_b = live_planes(&s.out_a, &s.on_a);
+    // Within the plane of a face f of A, B is bounded by the planes of those faces of
+    // B that reach plane f (B meets plane f, as f is live): only they can cut f.
+    faces_reaching_planes(b, &s.out_b, &s.on_b, &mut s.reach_b);
+    faces_reaching_planes(a, &s.out_a, &s.on_a, &mut s.reach_a);
+
+    // Faces of A clipped by B.
+    let mut s_a = Vector3::zeros();
+    let mut s_flush = Vector3::zeros();
+    for f in bits(live_a) {
+        let face = a.face(f);
+        let Some((cut, coplanar)) = face_masks(face, &s.out_a, &s.on_a) else {
+            continue;
+        };
+        let normal = a.planes()[f].normal;
+        let flush = bits(coplanar).any(|g| s.b_planes[g].normal.dot(&normal) > 0.0);
+        let cut = cut & transposed_bit(&s.reach_b, f);
+        s.poly.clear();
+        s.poly
+            .extend(face.iter().map(|&v| a.vertices()[v as usize]));
+        clip_by_mask(&mut s.poly, cut, &s.b_planes, &mut s.dist, &mut s.poly_tmp);
+        if s.poly.len() >= 3 {
+            let area = vector_area(&s.poly);
+            if flush {
+                s_flush += area
+            } else {
+                s_a += area
+            }
+            s.points.extend_from_slice(&s.poly);
+            s.starts.push(s.points.len() as u32);
+        }
+    }
+
+    // Faces of B clipped by A; a face lying in a plane of A of equal orientation is
+    // already covered by A's face.
+    let mut s_b = Vector3::zeros();
+    for g in bits(live_b) {
+        let face = b.face(g);
+        let Some((cut, coplanar)) = face_masks(face, &s.out_b, &s.on_b) else {
+            continue;
+        };
+        let normal = s.b_planes[g].normal;
+        if bits(coplanar).any(|f| a.planes()[f].normal.dot(&normal) > 0.0) {
+            continue;
+        }
+        let cut = cut & transposed_bit(&s.reach_a, g);
+        s.poly.clear();
+        s.poly.extend(face.iter().map(|&v| s.b_points[v as usize]));
+        clip_by_mask(&mut s.poly, cut, a.planes(), &mut s.dist, &mut s.poly_tmp);
+        if s.poly.len() >= 3 {
+            s_b += vector_area(&s.poly);
+            s.points.extend_from_slice(&s.poly);
+            s.starts.push(s.points.len() as u32);
+        }
+    }
+    // With flush pieces F left out of S_A: S_A + F + S_B = 0 on the closed surface,
+    // and the area vector without F from either side is S_A = −(S_B + F).
+    summarise(&s.points, &s.starts, s_a - s_b - s_flush)
+}
+
+/// Clips a face polygon by the planes in `cut`.
+#[inline]
+fn clip_by_mask(
+    poly: &mut Vec<Point3<Real>>,
+    cut: u64,
+    planes: &[Plane],
+    dist: &mut Vec<Real>,
+    tmp: &mut Vec<Point3<Real>>,
+) {
+    for k in bits(cut) {
+        clip_by_plane(poly, &planes[k], dist, tmp);
+        if poly.len() < 3 {
+            return;
+        }
+    }
+}
+
+/// For a face with vertex masks `out` and `on`: `None` when one plane has every vertex
+/// outside; otherwise the planes that cut it and those it lies in.
+#[inline]
+fn face_masks(face: &[u32], out: &[u64], on: &[u64]) -> Option<(u64, u64)> {
+    let (mut all_out, mut any_out, mut all_on) = (u64::MAX, 0u64, u64::MAX);
+    for &v in face {
+        let (o, n) = (out[v as usize], on[v as usize]);
+        all_out &= o;
+        any_out |= o;
+        all_on &= n;
+    }
+    (all_out == 0).then_some((any_out, all_on))
+}
+
+/// Indices of the set bits of `mask`, lowest first.
+#[inline]
+fn bits(mut mask: u64) -> impl Iterator<Item = usize> {
+    std::iter::from_fn(move || {
+        (mask != 0).then(|| {
+            let k = mask.trailing_zeros() as usize;
+            mask &= mask - 1;
+            k
+        })
+    })
+}
+
+/// The culling path for large meshes.
+fn overlap_culled(
+    a: &ConvexPolyhedron,
+    b: &ConvexPolyhedron,
+    b_in_a: &Pose,
+    s: &mut OverlapScratch,
+) -> Option<OverlapGeometry> {
+    if !matches!(gjk::gjk(a, b, b_in_a, None), GjkResult::Intersecting) {
+        return None;
+    }
+    let tol = tolerance(a, b);
+    let t = b_in_a.translation.vector;
+    let (ra, rb) = (a.circumradius(), b.circumradius());
+    // The region R: the box around both bounding spheres, cut to the slab across the
+    // line of centres that holds their lens (tight for shallow contacts).
+    let lo = (-Vector3::repeat(ra)).sup(&(t - Vector3::repeat(rb)));
+    let hi = Vector3::repeat(ra).inf(&(t + Vector3::repeat(rb)));
+    let distance = t.norm();
+    let mut region = box_planes(&lo, &hi).to_vec();
+    if distance > 0.0 {
+        let u = t / distance;
+        region.push(Plane {
+            normal: u,
+            offset: ra.min(distance + rb),
+        });
+        region.push(Plane {
+            normal: -u,
+            offset: -(distance - rb).max(-ra),
+        });
+    }
+    let touches_region = |c: &Point3<Real>, r: Real| region.iter().all(|p| p.distance(c) <= r);
     s.a_faces.clear();
     s.a_faces.extend((0..a.face_count() as u32).filter(|&f| {
         let (c, r) = a.face_spheres()[f as usize];
         touches_region(&c, r)
     }));
     s.b_faces.clear();
-    s.b_faces.extend((0..b.face_count() as u32).filter(|&g| {
-        let (c, r) = b.face_spheres()[g as usize];
-        touches_region(&b_in_a.transform_point(&c), r)
-    }));
-    if s.a_faces.is_empty() && s.b_faces.is_empty() {
-        return None;
-    }
-
-    // Vertex–plane distances for small shapes; planes that leave all of the other
-    // shape inside are dropped, and one that leaves all of it outside separates.
-    let matrix = !cull;
-    if matrix {
-        if !distance_matrix(
-            a.vertices(),
-            &s.b_planes,
-            &s.b_faces,
-            tol,
-            &mut s.dist_a,
-            &mut s.b_plane_ids,
-        ) || !distance_matrix(
-            &s.b_points,
-            a.planes(),
-            &s.a_faces,
-            tol,
-            &mut s.dist_b,
-            &mut s.a_plane_ids,
-        ) {
-            return None;
+    s.b_spheres.clear();
+    for g in 0..b.face_count() {
+        let (c, r) = b.face_spheres()[g];
+        let c = b_in_a.transform_point(&c);
+        if touches_region(&c, r) {
+            s.b_faces.push(g as u32);
         }
-    } else {
-        s.b_plane_ids.clear();
-        s.b_plane_ids.extend(s.b_faces.iter().map(|&g| g));
-        s.a_plane_ids.clear();
-        s.a_plane_ids.extend(s.a_faces.iter().map(|&f| f));
+        s.b_spheres.push((c, r));
     }
 
-    let region_planes = region.map(|(lo, hi)| box_planes(&lo, &hi));
-    s.points.clear();
-    s.starts.clear();
-    s.starts.push(0);
-
-    // Faces of A clipped by B.
     let mut s_a = Vector3::zeros();
     let mut s_flush = Vector3::zeros();
     for k in 0..s.a_faces.len() {
         let f = s.a_faces[k] as usize;
         let face = a.face(f);
-        let nv = a.vertices().len();
+        let points = face.iter().map(|&v| a.vertices()[v as usize]);
+        let sphere = a.face_spheres()[f];
         let Some(flush) = classify(
-            face,
+            points.clone(),
+            sphere,
             &a.planes()[f].normal,
             &s.b_planes,
-            &s.b_plane_ids,
-            |v, j| {
-                if matrix {
-                    s.dist_a[j * nv + v as usize]
-                } else {
-                    s.b_planes[s.b_plane_ids[j] as usize].distance(&a.vertices()[v as usize])
-                }
-            },
+            &s.b_faces,
             tol,
             false,
             &mut s.cutting,
@@ -220,52 +498,33 @@ pub fn overlap_with(
             continue;
         };
         s.poly.clear();
-        s.poly
-            .extend(face.iter().map(|&v| a.vertices()[v as usize]));
-        let first = s.cutting.first().copied();
-        clip_face(
-            &mut s.poly,
-            &mut s.poly_tmp,
-            &mut s.dist,
-            first.filter(|_| matrix).map(|j| {
-                let j = j as usize;
-                face.iter().map(move |&v| j * nv + v as usize)
-            }),
-            &s.dist_a,
-            &s.cutting,
-            &s.b_planes,
-            &s.b_plane_ids,
-            region_planes.as_ref(),
-        );
+        s.poly.extend(points);
+        clip_to_region_and_planes(s, &region, |s, j| {
+            s.b_planes[s.b_faces[j as usize] as usize]
+        });
         if s.poly.len() >= 3 {
+            let area = vector_area(&s.poly);
             if flush {
-                s_flush += vector_area(&s.poly);
+                s_flush += area
             } else {
-                s_a += vector_area(&s.poly);
+                s_a += area
             }
             s.points.extend_from_slice(&s.poly);
             s.starts.push(s.points.len() as u32);
         }
     }
-
-    // Faces of B clipped by A.
     let mut s_b = Vector3::zeros();
     for k in 0..s.b_faces.len() {
         let g = s.b_faces[k] as usize;
         let face = b.face(g);
-        let nv = b.vertices().len();
+        let b_points = &s.b_points;
+        let points = face.iter().map(|&v| b_points[v as usize]);
         if classify(
-            face,
+            points.clone(),
+            s.b_spheres[g],
             &s.b_planes[g].normal,
             a.planes(),
-            &s.a_plane_ids,
-            |v, j| {
-                if matrix {
-                    s.dist_b[j * nv + v as usize]
-                } else {
-                    a.planes()[s.a_plane_ids[j] as usize].distance(&s.b_points[v as usize])
-                }
-            },
+            &s.a_faces,
             tol,
             true,
             &mut s.cutting,
@@ -276,101 +535,78 @@ pub fn overlap_with(
         }
         s.poly.clear();
         s.poly.extend(face.iter().map(|&v| s.b_points[v as usize]));
-        let first = s.cutting.first().copied();
-        clip_face(
-            &mut s.poly,
-            &mut s.poly_tmp,
-            &mut s.dist,
-            first.filter(|_| matrix).map(|j| {
-                let j = j as usize;
-                face.iter().map(move |&v| j * nv + v as usize)
-            }),
-            &s.dist_b,
-            &s.cutting,
-            a.planes(),
-            &s.a_plane_ids,
-            region_planes.as_ref(),
-        );
+        clip_to_region_and_planes(s, &region, |s, j| {
+            a.planes()[s.a_faces[j as usize] as usize]
+        });
         if s.poly.len() >= 3 {
             s_b += vector_area(&s.poly);
             s.points.extend_from_slice(&s.poly);
             s.starts.push(s.points.len() as u32);
         }
     }
-
-    // With flush pieces F left out of S_A: S_A + F + S_B = 0 on the closed surface,
-    // and the area vector without F from either side is S_A = −(S_B + F).
-    summarise(&s.points, &s.starts, s_a - s_b - s_flush, t)
+    summarise(&s.points, &s.starts, s_a - s_b - s_flush)
 }
 
-/// Fills `dist` with one row per candidate plane (distances of every vertex), keeping
-/// in `ids` the planes that cut the vertex set. Returns `false` if some plane has every
-/// vertex outside: the shapes are separated.
-fn distance_matrix(
-    vertices: &[Point3<Real>],
-    planes: &[Plane],
-    candidates: &[u32],
-    tol: Real,
-    dist: &mut Vec<Real>,
-    ids: &mut Vec<u32>,
-) -> bool {
-    dist.clear();
-    ids.clear();
-    for &g in candidates {
-        let plane = planes[g as usize];
-        let row = dist.len();
-        let mut lo = Real::INFINITY;
-        let mut hi = Real::NEG_INFINITY;
-        for v in vertices {
-            let d = plane.distance(v);
-            lo = lo.min(d);
-            hi = hi.max(d);
-            dist.push(d);
+/// Clips `s.poly` by the region box, then by the planes `plane(s, j)` for `j` in
+/// `s.cutting`.
+fn clip_to_region_and_planes(
+    s: &mut OverlapScratch,
+    region: &[Plane],
+    plane: impl Fn(&OverlapScratch, u32) -> Plane,
+) {
+    for p in region {
+        if s.poly.len() < 3 {
+            return;
         }
-        if lo > tol {
-            return false;
-        }
-        if hi < -tol {
-            // Everything strictly inside this plane: it clips nothing, and no face of
-            // the other shape lies in it.
-            dist.truncate(row);
-        } else {
-            ids.push(g);
-        }
+        clip_by_plane(&mut s.poly, p, &mut s.dist, &mut s.poly_tmp);
     }
-    true
+    for k in 0..s.cutting.len() {
+        if s.poly.len() < 3 {
+            return;
+        }
+        let p = plane(s, s.cutting[k]);
+        clip_by_plane(&mut s.poly, &p, &mut s.dist, &mut s.poly_tmp);
+    }
 }
 
-/// Decides how the face `face` (normal `normal`) meets the other solid's planes
-/// `planes[ids[j]]`, with `dist(v, j)` the distance of vertex `v` from plane `j`.
+/// Decides how a face (its points and normal) meets the other solid's candidate
+/// planes `planes[ids[j]]`.
 ///
 /// Returns `None` if the face lies wholly outside one plane, or (when
 /// `drop_coplanar`) lies in a plane of equal orientation. Otherwise `cutting` holds the
-/// positions `j` of the planes that cut it, in order, and the flag says whether the
-/// face lies in a plane of equal orientation (is flush).
+/// positions `j` of the planes that cut it, and the flag says whether the face lies in
+/// a plane of equal orientation (is flush).
 #[allow(clippy::too_many_arguments)]
 fn classify(
-    face: &[u32],
+    points: impl Iterator<Item = Point3<Real>> + Clone,
+    (centre, radius): (Point3<Real>, Real),
     normal: &Vector3<Real>,
     planes: &[Plane],
     ids: &[u32],
-    dist: impl Fn(u32, usize) -> Real,
     tol: Real,
     drop_coplanar: bool,
     cutting: &mut Vec<u32>,
 ) -> Option<bool> {
     cutting.clear();
     let mut flush = false;
-    for j in 0..ids.len() {
-        let mut lo = Real::INFINITY;
-        let mut hi = Real::NEG_INFINITY;
-        for &v in face {
-            let d = dist(v, j);
-            lo = lo.min(d);
-            hi = hi.max(d);
+    for (j, &id) in ids.iter().enumerate() {
+        let plane = planes[id as usize];
+        // The face's bounding sphere decides most planes with one dot product.
+        let dc = plane.distance(&centre);
+        if dc < -radius - tol {
+            continue;
         }
+        if dc > radius + tol {
+            return None;
+        }
+        let (lo, hi) = points
+            .clone()
+            .fold((Real::INFINITY, Real::NEG_INFINITY), |(lo, hi), p| {
+                let d = plane.distance(&p);
+                (lo.min(d), hi.max(d))
+            });
         if hi <= tol {
-            if lo >= -tol && planes[ids[j] as usize].normal.dot(normal) > 0.0 {
+            if lo >= -tol && plane.normal.dot(normal) > 0.0 {
                 if drop_coplanar {
                     return None;
                 }
@@ -386,76 +622,20 @@ fn classify(
     Some(flush)
 }
 
-/// Clips `poly` by the region box (if any) and then by the cutting planes. The first
-/// cut may reuse precomputed distances (`first_rows` indexes `matrix`).
-#[allow(clippy::too_many_arguments)]
-fn clip_face(
-    poly: &mut Vec<Point3<Real>>,
-    tmp: &mut Vec<Point3<Real>>,
-    dist: &mut Vec<Real>,
-    first_rows: Option<impl Iterator<Item = usize>>,
-    matrix: &[Real],
-    cutting: &[u32],
-    planes: &[Plane],
-    ids: &[u32],
-    region: Option<&[Plane; 6]>,
-) {
-    let mut rest = cutting;
-    if let Some(rows) = first_rows {
-        dist.clear();
-        dist.extend(rows.map(|r| matrix[r]));
-        clip_with_distances(poly, dist, tmp);
-        std::mem::swap(poly, tmp);
-        rest = &cutting[1..];
-    }
-    if let Some(box_planes) = region {
-        for plane in box_planes {
-            if poly.len() < 3 {
-                return;
-            }
-            clip_by_plane(poly, plane, dist, tmp);
-        }
-    }
-    for &j in rest {
-        if poly.len() < 3 {
-            return;
-        }
-        clip_by_plane(poly, &planes[ids[j as usize] as usize], dist, tmp);
-    }
-}
-
 /// The six outward planes of the box `[lo, hi]`.
 fn box_planes(lo: &Vector3<Real>, hi: &Vector3<Real>) -> [Plane; 6] {
-    let e = |k: usize, s: Real| {
-        let mut n = Vector3::zeros();
-        n[k] = s;
-        n
+    let plane = |k: usize, sign: Real, offset: Real| {
+        let mut normal = Vector3::zeros();
+        normal[k] = sign;
+        Plane { normal, offset }
     };
     [
-        Plane {
-            normal: e(0, 1.0),
-            offset: hi.x,
-        },
-        Plane {
-            normal: e(0, -1.0),
-            offset: -lo.x,
-        },
-        Plane {
-            normal: e(1, 1.0),
-            offset: hi.y,
-        },
-        Plane {
-            normal: e(1, -1.0),
-            offset: -lo.y,
-        },
-        Plane {
-            normal: e(2, 1.0),
-            offset: hi.z,
-        },
-        Plane {
-            normal: e(2, -1.0),
-            offset: -lo.z,
-        },
+        plane(0, 1.0, hi.x),
+        plane(0, -1.0, -lo.x),
+        plane(1, 1.0, hi.y),
+        plane(1, -1.0, -lo.y),
+        plane(2, 1.0, hi.z),
+        plane(2, -1.0, -lo.z),
     ]
 }
 
@@ -464,7 +644,6 @@ fn summarise(
     points: &[Point3<Real>],
     starts: &[u32],
     twice_area: Vector3<Real>,
-    fallback_normal: Vector3<Real>,
 ) -> Option<OverlapGeometry> {
     if points.is_empty() {
         return None;
@@ -484,12 +663,10 @@ fn summarise(
         return None;
     }
     let area = 0.5 * twice_area.norm();
-    // A shape inside another (or two coincident ones) has a vanishing area vector:
-    // the overlap volume is stationary, and the normal is only a convention.
+    // A shape inside another (or two coincident ones) has a vanishing area vector: the
+    // overlap volume is stationary, and the normal is only a convention.
     let normal = if area > 0.0 {
         twice_area / (2.0 * area)
-    } else if fallback_normal.norm_squared() > 0.0 {
-        fallback_normal.normalize()
     } else {
         Vector3::x()
     };
