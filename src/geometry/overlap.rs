@@ -45,7 +45,7 @@ use std::cell::RefCell;
 use nalgebra::{Point3, Vector3};
 
 use super::gjk::{self, GjkResult};
-use super::polygon::{ConeSums, clip_by_plane, vector_area};
+use super::polygon::{ConeSums, FixedPolygon, clip_by_plane, vector_area};
 use super::{ConvexPolyhedron, Plane, Pose};
 use crate::Real;
 
@@ -99,6 +99,7 @@ pub struct OverlapScratch {
     /// Bounding spheres of B's faces in A's frame.
     b_spheres: Vec<(Point3<Real>, Real)>,
     cutting: Vec<u32>,
+    fixed: Box<FixedPolygon>,
     poly: Vec<Point3<Real>>,
     poly_tmp: Vec<Point3<Real>>,
     dist: Vec<Real>,
@@ -131,12 +132,22 @@ pub fn overlap_with(
     if t.norm() >= a.circumradius() + b.circumradius() {
         return None;
     }
+    // A rotation matrix transforms points in half the work of a quaternion.
+    let rot = b_in_a.rotation.to_rotation_matrix();
     s.b_points.clear();
-    s.b_points
-        .extend(b.vertices().iter().map(|p| b_in_a.transform_point(p)));
+    s.b_points.extend(
+        b.vertices()
+            .iter()
+            .map(|p| Point3::from(rot * p.coords + t)),
+    );
     s.b_planes.clear();
-    s.b_planes
-        .extend(b.planes().iter().map(|p| p.transformed(b_in_a)));
+    s.b_planes.extend(b.planes().iter().map(|p| {
+        let normal = rot * p.normal;
+        Plane {
+            normal,
+            offset: p.offset + normal.dot(&t),
+        }
+    }));
     s.points.clear();
     s.starts.clear();
     s.starts.push(0);
@@ -345,18 +356,16 @@ fn overlap_masked(
         let normal = a.planes()[f].normal;
         let flush = bits(coplanar).any(|g| s.b_planes[g].normal.dot(&normal) > 0.0);
         let cut = cut & transposed_bit(&s.reach_b, f);
-        s.poly.clear();
-        s.poly
-            .extend(face.iter().map(|&v| a.vertices()[v as usize]));
-        clip_by_mask(&mut s.poly, cut, &s.b_planes, &mut s.dist, &mut s.poly_tmp);
-        if s.poly.len() >= 3 {
-            let area = vector_area(&s.poly);
+        s.fixed.set(face.iter().map(|&v| a.vertices()[v as usize]));
+        clip_by_mask(&mut s.fixed, cut, &s.b_planes);
+        if !s.fixed.is_degenerate() {
+            let area = vector_area(s.fixed.points());
             if flush {
                 s_flush += area
             } else {
                 s_a += area
             }
-            s.points.extend_from_slice(&s.poly);
+            s.points.extend_from_slice(s.fixed.points());
             s.starts.push(s.points.len() as u32);
         }
     }
@@ -374,12 +383,11 @@ fn overlap_masked(
             continue;
         }
         let cut = cut & transposed_bit(&s.reach_a, g);
-        s.poly.clear();
-        s.poly.extend(face.iter().map(|&v| s.b_points[v as usize]));
-        clip_by_mask(&mut s.poly, cut, a.planes(), &mut s.dist, &mut s.poly_tmp);
-        if s.poly.len() >= 3 {
-            s_b += vector_area(&s.poly);
-            s.points.extend_from_slice(&s.poly);
+        s.fixed.set(face.iter().map(|&v| s.b_points[v as usize]));
+        clip_by_mask(&mut s.fixed, cut, a.planes());
+        if !s.fixed.is_degenerate() {
+            s_b += vector_area(s.fixed.points());
+            s.points.extend_from_slice(s.fixed.points());
             s.starts.push(s.points.len() as u32);
         }
     }
@@ -390,16 +398,10 @@ fn overlap_masked(
 
 /// Clips a face polygon by the planes in `cut`.
 #[inline]
-fn clip_by_mask(
-    poly: &mut Vec<Point3<Real>>,
-    cut: u64,
-    planes: &[Plane],
-    dist: &mut Vec<Real>,
-    tmp: &mut Vec<Point3<Real>>,
-) {
+fn clip_by_mask(poly: &mut FixedPolygon, cut: u64, planes: &[Plane]) {
     for k in bits(cut) {
-        clip_by_plane(poly, &planes[k], dist, tmp);
-        if poly.len() < 3 {
+        poly.clip(&planes[k]);
+        if poly.is_degenerate() {
             return;
         }
     }

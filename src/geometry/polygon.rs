@@ -123,3 +123,103 @@ impl ConeSums {
         self.origin + self.moment24 / (4.0 * self.volume6)
     }
 }
+
+/// Most vertices a clipped face of a shape of at most 64 faces can have (a face has
+/// fewer than 64 vertices, and each of at most 64 cuts adds at most one).
+pub(crate) const MAX_CLIPPED: usize = 128;
+
+/// A convex polygon in a fixed-size double buffer, clipped without allocation.
+#[derive(Clone, Debug)]
+pub(crate) struct FixedPolygon {
+    buffers: [[Point3<Real>; MAX_CLIPPED]; 2],
+    /// Which buffer holds the polygon.
+    current: usize,
+    len: usize,
+    dist: [Real; MAX_CLIPPED],
+}
+
+impl Default for FixedPolygon {
+    fn default() -> Self {
+        FixedPolygon {
+            buffers: [[Point3::origin(); MAX_CLIPPED]; 2],
+            current: 0,
+            len: 0,
+            dist: [0.0; MAX_CLIPPED],
+        }
+    }
+}
+
+impl FixedPolygon {
+    /// Replaces the polygon by `points` (at most [`MAX_CLIPPED`]).
+    #[inline]
+    pub(crate) fn set(&mut self, points: impl Iterator<Item = Point3<Real>>) {
+        self.len = 0;
+        let buffer = &mut self.buffers[self.current];
+        for p in points.take(MAX_CLIPPED) {
+            buffer[self.len] = p;
+            self.len += 1;
+        }
+    }
+
+    /// The vertices.
+    #[inline]
+    pub(crate) fn points(&self) -> &[Point3<Real>] {
+        &self.buffers[self.current][..self.len]
+    }
+
+    /// Whether fewer than three vertices remain.
+    #[inline]
+    pub(crate) fn is_degenerate(&self) -> bool {
+        self.len < 3
+    }
+
+    /// Clips to the inside of `plane` (same cut-point rule as [`clip_with_distances`]).
+    #[inline]
+    pub(crate) fn clip(&mut self, plane: &Plane) {
+        let n = self.len;
+        let [first, second] = &mut self.buffers;
+        let (input, output) = if self.current == 0 {
+            (first, second)
+        } else {
+            (second, first)
+        };
+        let mut any_out = false;
+        let mut any_in = false;
+        for (p, d) in input[..n].iter().zip(&mut self.dist) {
+            *d = plane.distance(p);
+            any_out |= *d > 0.0;
+            any_in |= *d <= 0.0;
+        }
+        if !any_out {
+            return;
+        }
+        if !any_in {
+            self.len = 0;
+            return;
+        }
+        // A convex polygon crossing a plane gains at most one vertex, so the buffer
+        // cannot overflow; the bound only guards against a non-convex input.
+        let mut m = 0;
+        let mut push = |p: Point3<Real>| {
+            if m < MAX_CLIPPED {
+                output[m] = p;
+                m += 1;
+            }
+        };
+        for k in 0..n {
+            let j = if k + 1 == n { 0 } else { k + 1 };
+            let (p, dp) = (input[k], self.dist[k]);
+            let (q, dq) = (input[j], self.dist[j]);
+            if dp <= 0.0 {
+                push(p);
+                if dq > 0.0 {
+                    push(cut(&p, dp, &q, dq));
+                }
+            } else if dq <= 0.0 {
+                push(cut(&q, dq, &p, dp));
+            }
+        }
+        self.current ^= 1;
+        self.len = m;
+    }
+}
