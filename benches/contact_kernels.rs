@@ -16,6 +16,7 @@ use talus::geometry::ConvexPolyhedron;
 use talus::geometry::generators;
 use talus::geometry::gjk::gjk;
 use talus::geometry::overlap::{OverlapScratch, overlap_with};
+use talus::geometry::wall::polyhedron_triangle;
 
 const PAIRS: usize = 64;
 
@@ -142,5 +143,30 @@ fn main() {
             });
             println!("{:<34} {:>12} {:>10.0} {:>12.0}", name, level, g, o);
         }
+    }
+
+    // Particle against one wall facet (a triangle twice the particle's size), pressed
+    // 2 % of the circumradius into it, at random orientations and offsets.
+    println!();
+    println!("{:<34} {:>12} {:>10} {:>12}", "particle vs wall facet", "depth", "", "facet ns");
+    let mut rng = Pcg64::seed_from_u64(7);
+    for (name, shape) in &shapes {
+        let r = shape.circumradius();
+        let tris: Vec<[nalgebra::Point3<f64>; 3]> = (0..PAIRS)
+            .map(|_| {
+                let rot = random_rotation(&mut rng);
+                let lowest = shape.vertices()[shape.support_index(&(rot.inverse() * -Vector3::z()), 0)];
+                let z = (rot * lowest.coords).z + 0.02 * r;
+                let (dx, dy) = (rng.random_range(-r..r), rng.random_range(-r..r));
+                let world = [
+                    nalgebra::Point3::new(-2.0 * r + dx, -2.0 * r + dy, z),
+                    nalgebra::Point3::new(2.0 * r + dx, -2.0 * r + dy, z),
+                    nalgebra::Point3::new(dx, 2.0 * r + dy, z),
+                ];
+                world.map(|p| nalgebra::Point3::from(rot.inverse() * p.coords))
+            })
+            .collect();
+        let t = time_per_call(|| tris.iter().filter(|t| polyhedron_triangle(shape, t).is_some()).count());
+        println!("{:<34} {:>12} {:>10} {:>12.0}", name, "2% of R", "", t);
     }
 }

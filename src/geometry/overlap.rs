@@ -686,3 +686,30 @@ fn summarise(
         depth: hi - lo,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The AVX2 plane test gives the same bits as the scalar one, also for points on
+    /// and near the planes.
+    #[test]
+    fn vector_and_scalar_plane_masks_agree() {
+        let d = crate::geometry::generators::dodecahedron(1.0).unwrap();
+        let mut soa = PlaneSoa::default();
+        soa.fill(d.planes());
+        let tol = 1e-12;
+        let mut points: Vec<Point3<Real>> = d.vertices().to_vec();
+        for (k, v) in d.vertices().iter().enumerate() {
+            let s = 1.0 + (k as Real - 10.0) * 1e-13;
+            points.push(Point3::from(v.coords * s));
+            points.push(Point3::from(v.coords * (0.5 + 0.1 * k as Real)));
+        }
+        let (mut o1, mut n1, mut o2, mut n2) = (vec![], vec![], vec![], vec![]);
+        plane_masks_scalar(&points, &soa, tol, &mut o1, &mut n1);
+        plane_masks(&points, &soa, tol, &mut o2, &mut n2);
+        assert_eq!(o1, o2);
+        assert_eq!(n1, n2);
+        assert!(n1.iter().any(|&m| m != 0) && o1.iter().any(|&m| m != 0));
+    }
+}

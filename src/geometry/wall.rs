@@ -22,9 +22,11 @@
 //! the contact law to each patch's sums, sharing the force among the facets in
 //! proportion to their volumes.
 
+use std::cell::RefCell;
+
 use nalgebra::{Point3, Vector3};
 
-use super::polygon::{ConeSums, clip_by_plane, vector_area};
+use super::polygon::{ConeSums, FixedPolygon, vector_area};
 use super::sphere::closest_point_on_triangle;
 use super::{ConvexPolyhedron, Plane};
 use crate::Real;
@@ -50,13 +52,26 @@ pub struct FacetOverlap {
     pub facet_normal: Vector3<Real>,
 }
 
+/// Reusable buffers of [`polyhedron_triangle`].
+#[derive(Default, Debug)]
+struct WallScratch {
+    poly: Box<FixedPolygon>,
+    points: Vec<Point3<Real>>,
+    starts: Vec<usize>,
+}
+
+thread_local! {
+    static SCRATCH: RefCell<WallScratch> = RefCell::new(WallScratch::default());
+}
+
 /// Overlap of `poly` with the prism under the triangle `tri` (given in the particle's
 /// body frame, counter-clockwise seen from the particle side). `None` if they do not
 /// overlap.
-pub fn polyhedron_triangle(
-    poly: &ConvexPolyhedron,
-    tri: &[Point3<Real>; 3],
-) -> Option<FacetOverlap> {
+pub fn polyhedron_triangle(poly: &ConvexPolyhedron, tri: &[Point3<Real>; 3]) -> Option<FacetOverlap> {
+    SCRATCH.with(|s| facet_overlap(poly, tri, &mut s.borrow_mut()))
+}
+
+fn facet_overlap(poly: &ConvexPolyhedron, tri: &[Point3<Real>; 3], s: &mut WallScratch) -> Option<FacetOverlap> {
     let (closest, _) = closest_point_on_triangle(tri, &Point3::origin());
     if closest.coords.norm() >= poly.circumradius() {
         return None;
@@ -85,26 +100,24 @@ pub fn polyhedron_triangle(
         };
     }
 
-    let mut points: Vec<Point3<Real>> = Vec::with_capacity(64);
-    let mut starts: Vec<usize> = vec![0];
-    let mut poly_buf = Vec::with_capacity(16);
-    let mut tmp = Vec::with_capacity(16);
-    let mut dist = Vec::with_capacity(16);
+    let WallScratch { poly: clipped, points, starts } = s;
+    points.clear();
+    starts.clear();
+    starts.push(0);
 
     // Faces of the particle clipped to the prism.
     let mut grad_p = Vector3::zeros();
     for f in 0..poly.face_count() {
-        poly_buf.clear();
-        poly_buf.extend(poly.face(f).iter().map(|&v| poly.vertices()[v as usize]));
+        clipped.set(poly.face(f).iter().map(|&v| poly.vertices()[v as usize]));
         for plane in &planes {
-            clip_by_plane(&mut poly_buf, plane, &mut dist, &mut tmp);
-            if poly_buf.len() < 3 {
+            clipped.clip(plane);
+            if clipped.is_degenerate() {
                 break;
             }
         }
-        if poly_buf.len() >= 3 {
-            grad_p += vector_area(&poly_buf);
-            points.extend_from_slice(&poly_buf);
+        if !clipped.is_degenerate() {
+            grad_p += vector_area(clipped.points());
+            points.extend_from_slice(clipped.points());
             starts.push(points.len());
         }
     }
@@ -118,26 +131,25 @@ pub fn polyhedron_triangle(
     let mut section_area = 0.0;
     let mut grad_q = Vector3::zeros();
     for side in 0..4 {
-        poly_buf.clear();
         if side == 0 {
-            poly_buf.extend_from_slice(tri);
+            clipped.set(tri.iter().copied());
         } else {
             let (a, b) = (tri[side - 1], tri[side % 3]);
-            poly_buf.extend_from_slice(&[a, a - n * reach, b - n * reach, b]);
+            clipped.set([a, a - n * reach, b - n * reach, b].into_iter());
         }
         for plane in poly.planes() {
-            clip_by_plane(&mut poly_buf, plane, &mut dist, &mut tmp);
-            if poly_buf.len() < 3 {
+            clipped.clip(plane);
+            if clipped.is_degenerate() {
                 break;
             }
         }
-        if poly_buf.len() >= 3 {
-            let s = vector_area(&poly_buf);
+        if !clipped.is_degenerate() {
+            let area = vector_area(clipped.points());
             if side == 0 {
-                section_area = s.norm();
+                section_area = area.norm();
             }
-            grad_q += s;
-            points.extend_from_slice(&poly_buf);
+            grad_q += area;
+            points.extend_from_slice(clipped.points());
             starts.push(points.len());
         }
     }
