@@ -148,14 +148,18 @@ fn main() {
     // Particle against one wall facet (a triangle twice the particle's size), pressed
     // 2 % of the circumradius into it, at random orientations and offsets.
     println!();
-    println!("{:<34} {:>12} {:>10} {:>12}", "particle vs wall facet", "depth", "", "facet ns");
+    println!(
+        "{:<34} {:>12} {:>10} {:>12}",
+        "particle vs wall facet", "depth", "", "facet ns"
+    );
     let mut rng = Pcg64::seed_from_u64(7);
     for (name, shape) in &shapes {
         let r = shape.circumradius();
         let tris: Vec<[nalgebra::Point3<f64>; 3]> = (0..PAIRS)
             .map(|_| {
                 let rot = random_rotation(&mut rng);
-                let lowest = shape.vertices()[shape.support_index(&(rot.inverse() * -Vector3::z()), 0)];
+                let lowest =
+                    shape.vertices()[shape.support_index(&(rot.inverse() * -Vector3::z()), 0)];
                 let z = (rot * lowest.coords).z + 0.02 * r;
                 let (dx, dy) = (rng.random_range(-r..r), rng.random_range(-r..r));
                 let world = [
@@ -166,7 +170,11 @@ fn main() {
                 world.map(|p| nalgebra::Point3::from(rot.inverse() * p.coords))
             })
             .collect();
-        let t = time_per_call(|| tris.iter().filter(|t| polyhedron_triangle(shape, t).is_some()).count());
+        let t = time_per_call(|| {
+            tris.iter()
+                .filter(|t| polyhedron_triangle(shape, t).is_some())
+                .count()
+        });
         println!("{:<34} {:>12} {:>10} {:>12.0}", name, "2% of R", "", t);
     }
 }

@@ -452,3 +452,55 @@ fn size_ratio_of_100() {
         assert!((o2.volume - o.volume).abs() < 1e-12 * small.volume());
     }
 }
+
+// ---- Large meshes (the culled, local-clipping path) ---------------------------------
+
+#[test]
+fn large_meshes_agree_with_monte_carlo() {
+    let ico = generators::icosphere(2, 0.01).unwrap();
+    let cube = generators::cuboid(0.012, 0.012, 0.012).unwrap();
+    let cases = [
+        (&ico, &ico, pose([0.016, 0.002, -0.001], [0.3, 1.2, -0.7])),
+        (&ico, &ico, pose([0.008, -0.004, 0.003], [2.0, 0.1, 0.4])),
+        (&ico, &cube, pose([0.009, 0.004, 0.0], [0.2, 0.3, 0.4])),
+        (&cube, &ico, pose([-0.004, 0.0, 0.012], [0.0, 0.0, 0.0])),
+    ];
+    for (k, (a, b, rel)) in cases.iter().enumerate() {
+        let exact = overlap(a, b, rel).map_or(0.0, |o| o.volume);
+        let (mc, se) = monte_carlo_overlap(a, b, rel, 400_000, k as u64);
+        assert!(exact > 0.0);
+        assert!(
+            (exact - mc).abs() <= 4.0 * se,
+            "case {k}: exact {exact:e}, MC {mc:e} ± {se:e}"
+        );
+    }
+}
+
+#[test]
+fn large_meshes_coincident_nested_and_gradient() {
+    let ico = generators::icosphere(2, 1.0).unwrap();
+    let o = overlap(&ico, &ico, &Isometry3::identity()).unwrap();
+    assert!((o.volume - ico.volume()).abs() < 1e-12 * ico.volume());
+    let small = generators::cuboid(0.2, 0.3, 0.1).unwrap();
+    let o = overlap(&ico, &small, &pose([0.1, 0.2, -0.3], [0.5, 0.0, 1.0])).unwrap();
+    assert!((o.volume - small.volume()).abs() < 1e-14);
+    // The area vector is the volume gradient here too.
+    let rel = pose([1.5, 0.2, -0.1], [0.3, -0.2, 0.9]);
+    let o = overlap(&ico, &ico, &rel).unwrap();
+    let h = 1e-7;
+    let mut grad = Vector3::zeros();
+    for k in 0..3 {
+        let mut dp = Vector3::zeros();
+        dp[k] = h;
+        let plus = Isometry3::from_parts((rel.translation.vector + dp).into(), rel.rotation);
+        let minus = Isometry3::from_parts((rel.translation.vector - dp).into(), rel.rotation);
+        grad[k] = (overlap(&ico, &ico, &plus).unwrap().volume
+            - overlap(&ico, &ico, &minus).unwrap().volume)
+            / (2.0 * h);
+    }
+    assert!(
+        (grad + o.area_vector()).norm() < 1e-5 * o.area,
+        "{grad} vs {}",
+        -o.area_vector()
+    );
+}

@@ -46,6 +46,7 @@ use nalgebra::{Point3, Vector3};
 
 use super::gjk::{self, GjkResult};
 use super::polygon::{ConeSums, FixedPolygon, clip_by_plane, vector_area};
+use super::sphere::closest_point_on_triangle;
 use super::{ConvexPolyhedron, Plane, Pose};
 use crate::Real;
 
@@ -85,6 +86,9 @@ pub struct OverlapScratch {
     b_points: Vec<Point3<Real>>,
     b_planes: Vec<Plane>,
     soa: PlaneSoa,
+    /// All planes of A and B (culled path).
+    a_soa: PlaneSoa,
+    b_soa: PlaneSoa,
     /// Per face of A (B): the planes of B (A) it reaches.
     reach_a: Vec<u64>,
     reach_b: Vec<u64>,
@@ -96,8 +100,13 @@ pub struct OverlapScratch {
     on_b: Vec<u64>,
     a_faces: Vec<u32>,
     b_faces: Vec<u32>,
-    /// Bounding spheres of B's faces in A's frame.
+    /// Bounding spheres of A's faces, and of B's faces in A's frame.
+    a_spheres: Vec<(Point3<Real>, Real)>,
     b_spheres: Vec<(Point3<Real>, Real)>,
+    /// Faces of the other shape near one face, and candidates sorted along an axis
+    /// (culled path).
+    local: Vec<u32>,
+    sorted: Vec<(Real, u32)>,
     cutting: Vec<u32>,
     fixed: Box<FixedPolygon>,
     poly: Vec<Point3<Real>>,
@@ -174,6 +183,21 @@ struct PlaneSoa {
 }
 
 impl PlaneSoa {
+    /// Largest signed distance of `p` from the planes: positive when outside the solid
+    /// they bound.
+    fn max_distance(&self, p: &Point3<Real>) -> Real {
+        let mut lanes = [Real::NEG_INFINITY; 4];
+        for c in 0..self.nx.len() / 4 {
+            for (l, lane) in lanes.iter_mut().enumerate() {
+                let k = 4 * c + l;
+                let d = self.nx[k] * p.x + self.ny[k] * p.y + self.nz[k] * p.z - self.offset[k];
+                // A plain select (not f64::max) so that the loop vectorises.
+                *lane = if d > *lane { d } else { *lane };
+            }
+        }
+        lanes.iter().copied().fold(Real::NEG_INFINITY, Real::max)
+    }
+
     fn fill(&mut self, planes: &[Plane]) {
         let n = planes.len().next_multiple_of(4);
         for v in [&mut self.nx, &mut self.ny, &mut self.nz, &mut self.offset] {
@@ -480,95 +504,247 @@ fn overlap_culled(
         s.b_spheres.push((c, r));
     }
 
-    let mut s_a = Vector3::zeros();
-    let mut s_flush = Vector3::zeros();
-    for k in 0..s.a_faces.len() {
-        let f = s.a_faces[k] as usize;
-        let face = a.face(f);
-        let points = face.iter().map(|&v| a.vertices()[v as usize]);
-        let sphere = a.face_spheres()[f];
+    s.a_spheres.clear();
+    s.a_spheres.extend_from_slice(a.face_spheres());
+    s.a_soa.fill(a.planes());
+    s.b_soa.fill(&s.b_planes);
+    let OverlapScratch {
+        a_soa,
+        b_soa,
+        b_points,
+        b_planes,
+        a_faces,
+        b_faces,
+        a_spheres,
+        b_spheres,
+        local,
+        sorted,
+        cutting,
+        poly,
+        poly_tmp,
+        dist,
+        points,
+        starts,
+        ..
+    } = s;
+    let mut out = LocalClipOutput {
+        local,
+        sorted,
+        cutting,
+        poly,
+        tmp: poly_tmp,
+        dist,
+        points,
+        starts,
+    };
+    let (s_a, s_flush) = clip_faces_locally(
+        LocalSide {
+            shape: a,
+            points: a.vertices(),
+            planes: a.planes(),
+            spheres: a_spheres,
+            ids: a_faces,
+            soa: a_soa,
+        },
+        LocalSide {
+            shape: b,
+            points: b_points,
+            planes: b_planes,
+            spheres: b_spheres,
+            ids: b_faces,
+            soa: b_soa,
+        },
+        &region,
+        tol,
+        false,
+        &mut out,
+    );
+    let (s_b, _) = clip_faces_locally(
+        LocalSide {
+            shape: b,
+            points: b_points,
+            planes: b_planes,
+            spheres: b_spheres,
+            ids: b_faces,
+            soa: b_soa,
+        },
+        LocalSide {
+            shape: a,
+            points: a.vertices(),
+            planes: a.planes(),
+            spheres: a_spheres,
+            ids: a_faces,
+            soa: a_soa,
+        },
+        &region,
+        tol,
+        true,
+        &mut out,
+    );
+    summarise(out.points, out.starts, s_a - s_b - s_flush)
+}
+
+/// One shape as seen by the culled path, everything in A's frame.
+struct LocalSide<'a> {
+    shape: &'a ConvexPolyhedron,
+    points: &'a [Point3<Real>],
+    planes: &'a [Plane],
+    spheres: &'a [(Point3<Real>, Real)],
+    /// Faces meeting the region R.
+    ids: &'a [u32],
+    /// All planes, for point-in-solid tests.
+    soa: &'a PlaneSoa,
+}
+
+/// The coordinate axis along which `points` spread the most.
+fn widest_axis(points: impl Iterator<Item = Point3<Real>>) -> usize {
+    let (lo, hi) = points.fold(
+        (
+            Vector3::repeat(Real::INFINITY),
+            Vector3::repeat(Real::NEG_INFINITY),
+        ),
+        |(lo, hi), p| (lo.inf(&p.coords), hi.sup(&p.coords)),
+    );
+    (hi - lo).imax()
+}
+
+/// Whether some face among `local` of `side` has a point in the ball and the region.
+fn local_face_meets_ball(
+    side: &LocalSide,
+    local: &[u32],
+    centre: Point3<Real>,
+    radius: Real,
+    region: &[Plane],
+) -> bool {
+    let r2 = radius * radius;
+    local.iter().any(|&g| {
+        let face = side.shape.face(g as usize);
+        let p0 = side.points[face[0] as usize];
+        (1..face.len() - 1).any(|k| {
+            let tri = [
+                p0,
+                side.points[face[k] as usize],
+                side.points[face[k + 1] as usize],
+            ];
+            let (q, _) = closest_point_on_triangle(&tri, &centre);
+            (q - centre).norm_squared() <= r2 && region.iter().all(|p| p.distance(&q) <= 0.0)
+        })
+    })
+}
+
+/// Buffers the culled path writes to.
+struct LocalClipOutput<'a> {
+    local: &'a mut Vec<u32>,
+    sorted: &'a mut Vec<(Real, u32)>,
+    cutting: &'a mut Vec<u32>,
+    poly: &'a mut Vec<Point3<Real>>,
+    tmp: &'a mut Vec<Point3<Real>>,
+    dist: &'a mut Vec<Real>,
+    points: &'a mut Vec<Point3<Real>>,
+    starts: &'a mut Vec<u32>,
+}
+
+/// Clips every candidate face of `own` by the other shape, locally: within the ball
+/// `S_f` around face f, the other solid (if it meets `S_f ∩ R`) is bounded by the
+/// planes of its faces that meet that ball, so only those cut f (besides R itself). The
+/// sphere tests are conservative, so a non-empty piece is kept only if its centroid
+/// lies in the other solid. Returns the summed vector areas of the pieces (not flush,
+/// flush).
+fn clip_faces_locally(
+    own: LocalSide,
+    other: LocalSide,
+    region: &[Plane],
+    tol: Real,
+    drop_coplanar: bool,
+    out: &mut LocalClipOutput,
+) -> (Vector3<Real>, Vector3<Real>) {
+    let mut area = Vector3::zeros();
+    let mut flush_area = Vector3::zeros();
+    let inside_tol = 1e3 * tol;
+    // The other side's faces sorted along the axis of their widest spread, so that
+    // each face finds its neighbours in a window instead of a full scan.
+    let axis = widest_axis(other.ids.iter().map(|&g| other.spheres[g as usize].0));
+    out.sorted.clear();
+    out.sorted.extend(
+        other
+            .ids
+            .iter()
+            .map(|&g| (other.spheres[g as usize].0[axis], g)),
+    );
+    out.sorted.sort_unstable_by(|x, y| x.0.total_cmp(&y.0));
+    let r_max = other
+        .ids
+        .iter()
+        .map(|&g| other.spheres[g as usize].1)
+        .fold(0.0, Real::max);
+    for &f in own.ids {
+        let f = f as usize;
+        let (centre, radius) = own.spheres[f];
+        let lo = out
+            .sorted
+            .partition_point(|e| e.0 < centre[axis] - radius - r_max);
+        let hi = out
+            .sorted
+            .partition_point(|e| e.0 <= centre[axis] + radius + r_max);
+        out.local.clear();
+        out.local
+            .extend(out.sorted[lo..hi].iter().map(|e| e.1).filter(|&g| {
+                let (c, r) = other.spheres[g as usize];
+                (c - centre).norm_squared() <= (r + radius) * (r + radius)
+            }));
+        let face = own.shape.face(f);
+        let face_points = face.iter().map(|&v| own.points[v as usize]);
         let Some(flush) = classify(
-            points.clone(),
-            sphere,
-            &a.planes()[f].normal,
-            &s.b_planes,
-            &s.b_faces,
+            face_points.clone(),
+            (centre, radius),
+            &own.planes[f].normal,
+            other.planes,
+            out.local,
             tol,
-            false,
-            &mut s.cutting,
+            drop_coplanar,
+            out.cutting,
         ) else {
             continue;
         };
-        s.poly.clear();
-        s.poly.extend(points);
-        clip_to_region_and_planes(s, &region, |s, j| {
-            s.b_planes[s.b_faces[j as usize] as usize]
-        });
-        if s.poly.len() >= 3 {
-            let area = vector_area(&s.poly);
-            if flush {
-                s_flush += area
-            } else {
-                s_a += area
+        out.poly.clear();
+        out.poly.extend(face_points);
+        for p in region {
+            if p.distance(&centre) > -radius {
+                clip_by_plane(out.poly, p, out.dist, out.tmp);
             }
-            s.points.extend_from_slice(&s.poly);
-            s.starts.push(s.points.len() as u32);
         }
-    }
-    let mut s_b = Vector3::zeros();
-    for k in 0..s.b_faces.len() {
-        let g = s.b_faces[k] as usize;
-        let face = b.face(g);
-        let b_points = &s.b_points;
-        let points = face.iter().map(|&v| b_points[v as usize]);
-        if classify(
-            points.clone(),
-            s.b_spheres[g],
-            &s.b_planes[g].normal,
-            a.planes(),
-            &s.a_faces,
-            tol,
-            true,
-            &mut s.cutting,
-        )
-        .is_none()
-        {
+        for &j in out.cutting.iter() {
+            if out.poly.len() < 3 {
+                break;
+            }
+            let plane = other.planes[out.local[j as usize] as usize];
+            clip_by_plane(out.poly, &plane, out.dist, out.tmp);
+        }
+        if out.poly.len() < 3 {
             continue;
         }
-        s.poly.clear();
-        s.poly.extend(face.iter().map(|&v| s.b_points[v as usize]));
-        clip_to_region_and_planes(s, &region, |s, j| {
-            a.planes()[s.a_faces[j as usize] as usize]
-        });
-        if s.poly.len() >= 3 {
-            s_b += vector_area(&s.poly);
-            s.points.extend_from_slice(&s.poly);
-            s.starts.push(s.points.len() as u32);
+        // Exact unless the other solid misses the ball: a point of one of its local
+        // faces inside the ball (and R) proves it does not; otherwise test the piece.
+        if !local_face_meets_ball(&other, out.local, centre, radius, region) {
+            let mean = out
+                .poly
+                .iter()
+                .fold(Vector3::zeros(), |acc, p| acc + p.coords)
+                / out.poly.len() as Real;
+            if other.soa.max_distance(&Point3::from(mean)) > inside_tol {
+                continue;
+            }
         }
-    }
-    summarise(&s.points, &s.starts, s_a - s_b - s_flush)
-}
-
-/// Clips `s.poly` by the region box, then by the planes `plane(s, j)` for `j` in
-/// `s.cutting`.
-fn clip_to_region_and_planes(
-    s: &mut OverlapScratch,
-    region: &[Plane],
-    plane: impl Fn(&OverlapScratch, u32) -> Plane,
-) {
-    for p in region {
-        if s.poly.len() < 3 {
-            return;
+        let piece = vector_area(out.poly);
+        if flush {
+            flush_area += piece;
+        } else {
+            area += piece;
         }
-        clip_by_plane(&mut s.poly, p, &mut s.dist, &mut s.poly_tmp);
+        out.points.extend_from_slice(out.poly);
+        out.starts.push(out.points.len() as u32);
     }
-    for k in 0..s.cutting.len() {
-        if s.poly.len() < 3 {
-            return;
-        }
-        let p = plane(s, s.cutting[k]);
-        clip_by_plane(&mut s.poly, &p, &mut s.dist, &mut s.poly_tmp);
-    }
+    (area, flush_area)
 }
 
 /// Decides how a face (its points and normal) meets the other solid's candidate

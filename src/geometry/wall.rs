@@ -67,11 +67,18 @@ thread_local! {
 /// Overlap of `poly` with the prism under the triangle `tri` (given in the particle's
 /// body frame, counter-clockwise seen from the particle side). `None` if they do not
 /// overlap.
-pub fn polyhedron_triangle(poly: &ConvexPolyhedron, tri: &[Point3<Real>; 3]) -> Option<FacetOverlap> {
+pub fn polyhedron_triangle(
+    poly: &ConvexPolyhedron,
+    tri: &[Point3<Real>; 3],
+) -> Option<FacetOverlap> {
     SCRATCH.with(|s| facet_overlap(poly, tri, &mut s.borrow_mut()))
 }
 
-fn facet_overlap(poly: &ConvexPolyhedron, tri: &[Point3<Real>; 3], s: &mut WallScratch) -> Option<FacetOverlap> {
+fn facet_overlap(
+    poly: &ConvexPolyhedron,
+    tri: &[Point3<Real>; 3],
+    s: &mut WallScratch,
+) -> Option<FacetOverlap> {
     let (closest, _) = closest_point_on_triangle(tri, &Point3::origin());
     if closest.coords.norm() >= poly.circumradius() {
         return None;
@@ -100,7 +107,11 @@ fn facet_overlap(poly: &ConvexPolyhedron, tri: &[Point3<Real>; 3], s: &mut WallS
         };
     }
 
-    let WallScratch { poly: clipped, points, starts } = s;
+    let WallScratch {
+        poly: clipped,
+        points,
+        starts,
+    } = s;
     points.clear();
     starts.clear();
     starts.push(0);
