@@ -229,6 +229,11 @@ pub fn icosphere(level: u32, radius: Real) -> Result<ConvexPolyhedron, GeometryE
 /// A random convex particle: the hull of `points` random directions on the sphere of
 /// radius `radius`, each pushed in or out by a uniform factor in
 /// `[1 - jitter, 1 + jitter]`. The same `seed` gives the same particle.
+///
+/// The triangle-based DEM draft (appendix E) scales the hull's vertices by a random
+/// factor in [0.75, 1] *after* taking the hull, which can make the particle slightly
+/// non-convex; here the jitter is applied before the hull so that the particle stays
+/// convex (`radius = 0.875 R, jitter = 1/7` gives the same radial range).
 pub fn random_convex(
     points: usize,
     radius: Real,
