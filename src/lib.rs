@@ -14,6 +14,7 @@
 // rewrite to `partial_cmp` would hide that intent.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+pub mod contact;
 pub mod geometry;
 
 /// The scalar type used throughout talus.
