@@ -15,6 +15,7 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod contact;
+pub mod engine;
 pub mod geometry;
 
 /// The scalar type used throughout talus.

@@ -1,0 +1,131 @@
+//! Time integration of rigid bodies.
+//!
+//! # Translation
+//! Velocity Verlet (kick–drift–kick with the force of the previous step).
+//!
+//! # Rotation: momentum kicks around an exact-invariant free rotation
+//! The torque acts as a half kick on the world-frame angular momentum before and after
+//! the free rotation of the body over the step. The free rotation integrates Euler's
+//! equations in the body frame, `L' = L × I⁻¹L`, with the implicit midpoint rule, and
+//! turns the orientation by the Cayley rotation of the midpoint angular velocity:
+//!
+//! `L₁ = C(h ω_m)ᵀ L₀`, `q₁ = q₀ ⊗ (1, h ω_m / 2)/‖·‖`, `ω_m = I⁻¹ (L₀ + L₁)/2`.
+//!
+//! The midpoint rule keeps every quadratic invariant of Euler's equations exactly —
+//! the kinetic energy `½ L·I⁻¹L` and `|L|²` — and because the body-frame update is
+//! itself the Cayley rotation `C`, turning the orientation by the same `C` keeps the
+//! world-frame angular momentum `R L` exactly too. (A plain explicit quaternion update
+//! drifts in both; a second-order splitting keeps them only to O(h²).) The implicit
+//! equation is solved by fixed-point iteration to round-off; it contracts at the rate
+//! `h |ω|`, so a few iterations suffice at the time steps DEM uses.
+
+use nalgebra::{Quaternion, UnitQuaternion, Vector3};
+
+use crate::Real;
+
+/// The rotational state of one rigid body.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RotationState {
+    /// Orientation: body frame to world frame.
+    pub orientation: UnitQuaternion<Real>,
+    /// Angular momentum in the world frame.
+    pub angular_momentum: Vector3<Real>,
+}
+
+impl RotationState {
+    /// Angular velocity in the world frame, for principal moments `inertia`.
+    pub fn angular_velocity(&self, inertia: &Vector3<Real>) -> Vector3<Real> {
+        let body = self
+            .orientation
+            .inverse_transform_vector(&self.angular_momentum);
+        self.orientation * body.component_div(inertia)
+    }
+
+    /// Rotational kinetic energy.
+    pub fn kinetic_energy(&self, inertia: &Vector3<Real>) -> Real {
+        let body = self
+            .orientation
+            .inverse_transform_vector(&self.angular_momentum);
+        0.5 * body.dot(&body.component_div(inertia))
+    }
+}
+
+/// First half of a rotation step: half kick with the torque at the start of the step,
+/// then the free rotation over `dt`. Finish the step with [`half_kick`] once the torque
+/// at the new orientation is known.
+pub fn rotate(
+    state: &mut RotationState,
+    inertia: &Vector3<Real>,
+    torque_start: &Vector3<Real>,
+    dt: Real,
+) {
+    half_kick(state, torque_start, dt);
+    free_rotation(state, inertia, dt);
+}
+
+/// Adds half a step's torque impulse to the angular momentum.
+#[inline]
+pub fn half_kick(state: &mut RotationState, torque: &Vector3<Real>, dt: Real) {
+    state.angular_momentum += torque * (0.5 * dt);
+}
+
+/// Torque-free rotation over `dt` (see the module docs).
+pub fn free_rotation(state: &mut RotationState, inertia: &Vector3<Real>, dt: Real) {
+    let l0 = state
+        .orientation
+        .inverse_transform_vector(&state.angular_momentum);
+    let inv_inertia = inertia.map(|i| 1.0 / i);
+    let scale = l0.norm().max(Real::MIN_POSITIVE);
+    let mut l1 = l0;
+    for _ in 0..64 {
+        let w = (0.5 * dt) * (0.5 * (l0 + l1)).component_mul(&inv_inertia);
+        let next = cayley_transpose(&w, &l0);
+        let change = (next - l1).norm();
+        l1 = next;
+        if change <= 1e-15 * scale {
+            break;
+        }
+    }
+    // Final midpoint velocity from the converged L₁, and the matching Cayley turn.
+    let w = (0.5 * dt) * (0.5 * (l0 + l1)).component_mul(&inv_inertia);
+    let l1 = cayley_transpose(&w, &l0);
+    let turn = UnitQuaternion::from_quaternion(Quaternion::new(1.0, w.x, w.y, w.z));
+    state.orientation = UnitQuaternion::new_normalize((state.orientation * turn).into_inner());
+    state.angular_momentum = state.orientation * l1;
+}
+
+/// `Cᵀ v` for the Cayley rotation `C = (1 − ŵ)⁻¹ (1 + ŵ)`, i.e. `(1 + ŵ)⁻¹ (1 − ŵ) v`:
+/// the rotation by the angle `2 atan |w|` about `w`, inverted.
+#[inline]
+fn cayley_transpose(w: &Vector3<Real>, v: &Vector3<Real>) -> Vector3<Real> {
+    // The quaternion (1, w)/‖·‖ represents C; its conjugate applied to v gives Cᵀ v.
+    let q = UnitQuaternion::from_quaternion(Quaternion::new(1.0, w.x, w.y, w.z));
+    q.inverse_transform_vector(v)
+}
+
+/// Velocity Verlet for translation: the first half kick and the drift.
+#[inline]
+pub fn kick_drift(
+    position: &mut Vector3<Real>,
+    velocity: &mut Vector3<Real>,
+    acceleration: &Vector3<Real>,
+    dt: Real,
+) {
+    *velocity += acceleration * (0.5 * dt);
+    *position += *velocity * dt;
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn cayley_quaternion_matches_the_matrix_form() {
+        let w = Vector3::new(0.3, -0.2, 0.5);
+        let v = Vector3::new(1.0, 2.0, -0.7);
+        let skew = w.cross_matrix();
+        let id = nalgebra::Matrix3::identity();
+        let c = (id - skew).try_inverse().unwrap() * (id + skew);
+        assert!((c.transpose() * v - cayley_transpose(&w, &v)).norm() < 1e-14);
+    }
+}
