@@ -17,6 +17,7 @@
 pub mod contact;
 pub mod engine;
 pub mod geometry;
+pub mod world;
 
 /// The scalar type used throughout talus.
 pub type Real = f64;

@@ -6,3 +6,4 @@
 
 pub mod broad_phase;
 pub mod integrate;
+pub mod step;

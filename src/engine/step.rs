@@ -1,0 +1,484 @@
+//! One time step on the CPU: kick and drift, broad phase, narrow phase and contact
+//! forces (in parallel over pairs and over particles), accumulation in a fixed order,
+//! and the closing kick.
+
+use std::collections::HashMap;
+
+use nalgebra::{Matrix3, Point3, UnitQuaternion, Vector3};
+use rayon::prelude::*;
+
+use super::broad_phase::BroadPhase;
+use super::integrate::{RotationState, free_rotation, half_kick};
+use crate::Real;
+use crate::contact::{DampingTable, NormalContact, PairStiffness, normal_force, tangential_force};
+use crate::geometry::Shape;
+use crate::geometry::overlap::overlap;
+use crate::geometry::sphere::{sphere_polyhedron, sphere_sphere, sphere_triangle};
+use crate::geometry::wall::polyhedron_triangle;
+use crate::world::World;
+
+/// Geometry of one contact in world coordinates, body 1 → body 2.
+#[derive(Clone, Copy, Debug)]
+struct ContactGeometry {
+    volume: Real,
+    area: Real,
+    depth: Real,
+    normal: Vector3<Real>,
+    point: Point3<Real>,
+}
+
+/// The force one contact puts on its second body, at its contact point.
+#[derive(Clone, Copy, Debug)]
+struct ContactForce {
+    force: Vector3<Real>,
+    point: Point3<Real>,
+    history: Vector3<Real>,
+}
+
+/// Key of a particle–wall contact patch: particle id, wall, and the patch plane
+/// (normal and offset rounded), so that friction history survives sliding from facet
+/// to facet of a flat wall.
+type WallKey = (u64, u32, [i64; 4]);
+
+/// The CPU engine: time step, contact history and reusable buffers.
+#[derive(Debug)]
+pub struct Engine {
+    /// Time step.
+    pub dt: Real,
+    broad: BroadPhase,
+    pairs: Vec<[u32; 2]>,
+    history: HashMap<(u64, u64), Vector3<Real>>,
+    wall_history: HashMap<WallKey, Vector3<Real>>,
+    damping: HashMap<u64, DampingTable>,
+    /// Number of particle–particle and particle–wall contacts in the last step.
+    pub contacts: usize,
+}
+
+impl Engine {
+    /// An engine stepping by `dt`.
+    pub fn new(dt: Real) -> Self {
+        Engine {
+            dt,
+            broad: BroadPhase::default(),
+            pairs: Vec::new(),
+            history: HashMap::new(),
+            wall_history: HashMap::new(),
+            damping: HashMap::new(),
+            contacts: 0,
+        }
+    }
+
+    /// Computes the forces of the current state (call once before the first step).
+    pub fn initialise(&mut self, world: &mut World) {
+        self.prepare_damping(world);
+        self.compute_forces(world);
+    }
+
+    /// Advances the world by one step.
+    pub fn step(&mut self, world: &mut World) {
+        let dt = self.dt;
+        let types = &world.body_types;
+        let p = &mut world.particles;
+        for i in 0..p.len() {
+            let t = &types[p.body_type[i] as usize];
+            p.velocity[i] += p.force[i] * (0.5 * dt / t.mass);
+            p.position[i] += p.velocity[i] * dt;
+            let mut rot = RotationState {
+                orientation: p.orientation[i],
+                angular_momentum: p.angular_momentum[i],
+            };
+            half_kick(&mut rot, &p.torque[i], dt);
+            free_rotation(&mut rot, &t.inertia, dt);
+            p.orientation[i] = rot.orientation;
+            p.angular_momentum[i] = rot.angular_momentum;
+        }
+        for wall in &mut world.walls {
+            let turn = UnitQuaternion::from_scaled_axis(wall.angular_velocity * dt);
+            wall.pose.translation.vector += wall.velocity * dt;
+            wall.pose.rotation = turn * wall.pose.rotation;
+        }
+        world.time += dt;
+        self.compute_forces(world);
+        let p = &mut world.particles;
+        for i in 0..p.len() {
+            let t = &types_of(&world.body_types, p.body_type[i]);
+            p.velocity[i] += p.force[i] * (0.5 * dt / t.0);
+            p.angular_momentum[i] += p.torque[i] * (0.5 * dt);
+        }
+    }
+
+    /// Calibrates the damping of every material pair once (a pair's restitution is
+    /// the mean of its materials').
+    fn prepare_damping(&mut self, world: &World) {
+        for a in &world.materials {
+            for b in &world.materials {
+                let e = pair_restitution(a.restitution, b.restitution);
+                self.damping
+                    .entry(e.to_bits())
+                    .or_insert_with(|| DampingTable::new(e));
+            }
+        }
+    }
+
+    /// Forces and torques of the current positions and velocities.
+    fn compute_forces(&mut self, world: &mut World) {
+        self.prepare_damping(world);
+        let n = world.particles.len();
+        for i in 0..n {
+            let m = world.body_types[world.particles.body_type[i] as usize].mass;
+            world.particles.force[i] = world.gravity * m;
+            world.particles.torque[i] = Vector3::zeros();
+        }
+        for wall in &mut world.walls {
+            wall.force = Vector3::zeros();
+            wall.torque = Vector3::zeros();
+        }
+        let radii: Vec<Real> = (0..n)
+            .map(|i| {
+                world.body_types[world.particles.body_type[i] as usize]
+                    .shape
+                    .circumradius()
+            })
+            .collect();
+        self.broad
+            .find_pairs(&world.particles.position, &radii, 0.0, &mut self.pairs);
+
+        let w = &*world;
+        let history = &self.history;
+        let damping = &self.damping;
+        let dt = self.dt;
+        let results: Vec<Option<ContactForce>> = self
+            .pairs
+            .par_iter()
+            .map(|&[i, j]| pair_force(w, i as usize, j as usize, history, damping, dt))
+            .collect();
+        let mut next_history = HashMap::with_capacity(results.len());
+        let mut contacts = 0;
+        for (&[i, j], r) in self.pairs.iter().zip(&results) {
+            let Some(c) = r else { continue };
+            let (i, j) = (i as usize, j as usize);
+            contacts += 1;
+            let p = &mut world.particles;
+            p.force[j] += c.force;
+            p.force[i] -= c.force;
+            p.torque[j] += (c.point - p.position[j]).cross(&c.force);
+            p.torque[i] -= (c.point - p.position[i]).cross(&c.force);
+            next_history.insert((p.id[i], p.id[j]), c.history);
+        }
+        self.history = next_history;
+
+        // Particles against walls, in parallel over particles.
+        let w = &*world;
+        let wall_history = &self.wall_history;
+        let wall_results: Vec<Vec<(u32, WallKey, ContactForce)>> = (0..n)
+            .into_par_iter()
+            .map(|i| wall_contacts(w, i, wall_history, damping, dt))
+            .collect();
+        let mut next_wall_history = HashMap::new();
+        for (i, list) in wall_results.into_iter().enumerate() {
+            for (wall, key, c) in list {
+                contacts += 1;
+                let p = &mut world.particles;
+                p.force[i] += c.force;
+                p.torque[i] += (c.point - p.position[i]).cross(&c.force);
+                let wall = &mut world.walls[wall as usize];
+                wall.force -= c.force;
+                wall.torque -=
+                    (c.point - Point3::from(wall.pose.translation.vector)).cross(&c.force);
+                next_wall_history.insert(key, c.history);
+            }
+        }
+        self.wall_history = next_wall_history;
+        self.contacts = contacts;
+    }
+}
+
+/// Restitution of a pair of materials.
+fn pair_restitution(a: Real, b: Real) -> Real {
+    0.5 * (a + b)
+}
+
+fn types_of(types: &[crate::world::BodyType], t: u32) -> (Real, Vector3<Real>) {
+    let t = &types[t as usize];
+    (t.mass, t.inertia)
+}
+
+/// World-frame inverse inertia of particle `i`.
+fn inverse_inertia(world: &World, i: usize) -> Matrix3<Real> {
+    let p = &world.particles;
+    let t = &world.body_types[p.body_type[i] as usize];
+    let r = p.orientation[i].to_rotation_matrix();
+    r.matrix() * Matrix3::from_diagonal(&t.inertia.map(|x| 1.0 / x)) * r.matrix().transpose()
+}
+
+/// Inverse of the effective mass of particle `i` at `point` along `n`.
+fn inverse_mass_at(world: &World, i: usize, point: &Point3<Real>, n: &Vector3<Real>) -> Real {
+    let p = &world.particles;
+    let t = &world.body_types[p.body_type[i] as usize];
+    let rn = (point - p.position[i]).cross(n);
+    1.0 / t.mass + rn.dot(&(inverse_inertia(world, i) * rn))
+}
+
+/// Velocity of particle `i`'s material at `point`.
+fn velocity_at(world: &World, i: usize, point: &Point3<Real>) -> Vector3<Real> {
+    world.particles.velocity[i]
+        + world
+            .angular_velocity(i)
+            .cross(&(point - world.particles.position[i]))
+}
+
+/// Contact geometry of particles `i` and `j` in world coordinates (normal i → j).
+fn pair_geometry(world: &World, i: usize, j: usize) -> Option<ContactGeometry> {
+    let p = &world.particles;
+    let (si, sj) = (
+        &world.body_types[p.body_type[i] as usize].shape,
+        &world.body_types[p.body_type[j] as usize].shape,
+    );
+    let pose =
+        |k: usize| nalgebra::Isometry3::from_parts(p.position[k].coords.into(), p.orientation[k]);
+    match (si, sj) {
+        (Shape::Polyhedron(a), Shape::Polyhedron(b)) => {
+            let (pi, pj) = (pose(i), pose(j));
+            let o = overlap(a, b, &(pi.inverse() * pj))?;
+            Some(ContactGeometry {
+                volume: o.volume,
+                area: o.area,
+                depth: o.depth,
+                normal: pi.rotation * o.normal,
+                point: pi * o.centroid,
+            })
+        }
+        (Shape::Sphere(a), Shape::Sphere(b)) => {
+            let c = sphere_sphere(a.radius, b.radius, &(p.position[j] - p.position[i]))?;
+            Some(ContactGeometry {
+                volume: c.volume,
+                area: c.area,
+                depth: c.depth,
+                normal: c.normal,
+                point: p.position[i] + c.point.coords,
+            })
+        }
+        (Shape::Polyhedron(a), Shape::Sphere(b)) => {
+            let pi = pose(i);
+            let c = sphere_polyhedron(a, &pi.inverse_transform_point(&p.position[j]), b.radius)?;
+            Some(ContactGeometry {
+                volume: c.volume,
+                area: c.area,
+                depth: c.depth,
+                normal: pi.rotation * c.normal,
+                point: pi * c.point,
+            })
+        }
+        (Shape::Sphere(_), Shape::Polyhedron(_)) => {
+            let mut g = pair_geometry(world, j, i)?;
+            g.normal = -g.normal;
+            Some(g)
+        }
+    }
+}
+
+/// Normal and tangential force on body 2 of a contact.
+#[allow(clippy::too_many_arguments)]
+fn contact_force(
+    g: &ContactGeometry,
+    relative_velocity: Vector3<Real>,
+    inverse_mass: Real,
+    stiffness: PairStiffness,
+    damping: &DampingTable,
+    friction: Real,
+    history: Vector3<Real>,
+    dt: Real,
+) -> ContactForce {
+    let effective_mass = 1.0 / inverse_mass;
+    let normal = normal_force(
+        &NormalContact {
+            volume: g.volume,
+            area: g.area,
+            depth: g.depth,
+            normal: g.normal,
+            relative_velocity,
+            effective_mass,
+            stiffness: stiffness.normal,
+            dt,
+        },
+        damping,
+    );
+    let kt = stiffness.tangential * g.area;
+    let ct = 2.0 * damping.zeta(1.0) * (effective_mass * kt).sqrt();
+    let t = tangential_force(
+        &history,
+        &g.normal,
+        &relative_velocity,
+        dt,
+        kt,
+        ct,
+        friction * normal.force.norm(),
+    );
+    ContactForce {
+        force: normal.force + t.force,
+        point: g.point,
+        history: t.history,
+    }
+}
+
+fn pair_force(
+    world: &World,
+    i: usize,
+    j: usize,
+    history: &HashMap<(u64, u64), Vector3<Real>>,
+    damping: &HashMap<u64, DampingTable>,
+    dt: Real,
+) -> Option<ContactForce> {
+    let g = pair_geometry(world, i, j)?;
+    let p = &world.particles;
+    let (ti, tj) = (
+        &world.body_types[p.body_type[i] as usize],
+        &world.body_types[p.body_type[j] as usize],
+    );
+    let (mi, mj) = (&world.materials[ti.material], &world.materials[tj.material]);
+    let stiffness = PairStiffness::particles(
+        mi,
+        ti.shape.equivalent_radius(),
+        mj,
+        tj.shape.equivalent_radius(),
+    );
+    // The pair's restitution and friction: the means of the two materials'.
+    let e = pair_restitution(mi.restitution, mj.restitution);
+    let table = damping
+        .get(&e.to_bits())
+        .cloned()
+        .unwrap_or_else(|| DampingTable::new(e));
+    let rel_v = velocity_at(world, j, &g.point) - velocity_at(world, i, &g.point);
+    let inv_m = inverse_mass_at(world, i, &g.point, &g.normal)
+        + inverse_mass_at(world, j, &g.point, &g.normal);
+    let h = history
+        .get(&(p.id[i], p.id[j]))
+        .copied()
+        .unwrap_or_default();
+    Some(contact_force(
+        &g,
+        rel_v,
+        inv_m,
+        stiffness,
+        &table,
+        0.5 * (mi.friction + mj.friction),
+        h,
+        dt,
+    ))
+}
+
+/// Contacts of particle `i` with every wall, one per coplanar patch of facets.
+fn wall_contacts(
+    world: &World,
+    i: usize,
+    history: &HashMap<WallKey, Vector3<Real>>,
+    damping: &HashMap<u64, DampingTable>,
+    dt: Real,
+) -> Vec<(u32, WallKey, ContactForce)> {
+    let p = &world.particles;
+    let t = &world.body_types[p.body_type[i] as usize];
+    let radius = t.shape.circumradius();
+    let pose = nalgebra::Isometry3::from_parts(p.position[i].coords.into(), p.orientation[i]);
+    let mut out = Vec::new();
+    let mut facets = Vec::new();
+    for (w, wall) in world.walls.iter().enumerate() {
+        wall.grid.query(
+            &wall.pose.inverse_transform_point(&p.position[i]),
+            radius,
+            &mut facets,
+        );
+        if facets.is_empty() {
+            continue;
+        }
+        // Patches: facets sharing a plane (to 1e-9 in the normal, 1e-9 R in offset).
+        let mut patches: Vec<([i64; 4], ContactGeometry)> = Vec::new();
+        for &f in &facets {
+            let tri = wall.facet_world(f as usize);
+            let n = (tri[1] - tri[0]).cross(&(tri[2] - tri[0])).normalize();
+            let key = [
+                (n.x * 1e9).round() as i64,
+                (n.y * 1e9).round() as i64,
+                (n.z * 1e9).round() as i64,
+                (n.dot(&tri[0].coords) / radius * 1e9).round() as i64,
+            ];
+            let g = match &t.shape {
+                Shape::Polyhedron(poly) => {
+                    let local = tri.map(|x| pose.inverse_transform_point(&x));
+                    polyhedron_triangle(poly, &local).map(|o| {
+                        let area = o.volume_gradient.norm();
+                        ContactGeometry {
+                            volume: o.volume,
+                            area,
+                            depth: o.depth,
+                            // The force on the particle is along −∇V: out of the wall.
+                            normal: -(pose.rotation * o.volume_gradient) / area,
+                            point: pose * o.centroid,
+                        }
+                    })
+                }
+                Shape::Sphere(s) => {
+                    sphere_triangle(&tri, &p.position[i], s.radius).map(|(c, _)| ContactGeometry {
+                        volume: c.volume,
+                        area: c.area,
+                        depth: c.depth,
+                        normal: c.normal,
+                        point: c.point,
+                    })
+                }
+            };
+            let Some(g) = g else { continue };
+            match patches.iter_mut().find(|(k, _)| *k == key) {
+                None => patches.push((key, g)),
+                Some((_, acc)) => match &t.shape {
+                    // Polyhedra: the facets' prisms tile the patch; sum them.
+                    Shape::Polyhedron(_) => {
+                        let v = acc.volume + g.volume;
+                        acc.point = Point3::from(
+                            (acc.point.coords * acc.volume + g.point.coords * g.volume) / v,
+                        );
+                        let sum = acc.normal * acc.area + g.normal * g.area;
+                        acc.area = sum.norm();
+                        acc.normal = sum / acc.area;
+                        acc.volume = v;
+                        acc.depth = acc.depth.max(g.depth);
+                    }
+                    // Spheres: the deepest facet of a flat patch is the plane contact.
+                    Shape::Sphere(_) => {
+                        if g.depth > acc.depth {
+                            *acc = g;
+                        }
+                    }
+                },
+            }
+        }
+        let wm = &world.materials[wall.material];
+        let pm = &world.materials[t.material];
+        let stiffness = PairStiffness::particle_wall(pm, t.shape.equivalent_radius(), wm);
+        let e = pair_restitution(pm.restitution, wm.restitution);
+        let table = damping
+            .get(&e.to_bits())
+            .cloned()
+            .unwrap_or_else(|| DampingTable::new(e));
+        for (key, g) in patches {
+            if !(g.area > 0.0) || !g.normal.iter().all(|x| x.is_finite()) {
+                continue;
+            }
+            let rel_v = velocity_at(world, i, &g.point) - wall.velocity_at(&g.point);
+            let inv_m = inverse_mass_at(world, i, &g.point, &g.normal);
+            let wall_key = (p.id[i], w as u32, key);
+            let h = history.get(&wall_key).copied().unwrap_or_default();
+            let c = contact_force(
+                &g,
+                rel_v,
+                inv_m,
+                stiffness,
+                &table,
+                0.5 * (pm.friction + wm.friction),
+                h,
+                dt,
+            );
+            out.push((w as u32, wall_key, c));
+        }
+    }
+    out
+}

@@ -1,0 +1,186 @@
+//! Triangulated walls and the grid that finds their facets near a point.
+
+use nalgebra::{Isometry3, Point3, Vector3};
+
+use crate::Real;
+
+/// A rigid triangulated wall. Its mesh is stored in the wall's own frame; `pose` places
+/// that frame in the world, so a rigidly moving wall never rebuilds its facet grid.
+#[derive(Clone, Debug)]
+pub struct Wall {
+    /// Name, for output and co-simulation variables.
+    pub name: String,
+    /// Index into the world's materials.
+    pub material: usize,
+    /// Vertices in the wall frame.
+    pub vertices: Vec<Point3<Real>>,
+    /// Facets, counter-clockwise seen from the side particles are on.
+    pub triangles: Vec<[u32; 3]>,
+    /// Wall frame in the world.
+    pub pose: Isometry3<Real>,
+    /// Linear velocity of the wall frame's origin.
+    pub velocity: Vector3<Real>,
+    /// Angular velocity of the wall (world frame).
+    pub angular_velocity: Vector3<Real>,
+    /// Facet lookup in the wall frame.
+    pub grid: FacetGrid,
+    /// Force the particles exert on the wall in the current step.
+    pub force: Vector3<Real>,
+    /// Torque the particles exert about the wall frame's origin.
+    pub torque: Vector3<Real>,
+}
+
+impl Wall {
+    /// A static wall from a mesh given in world coordinates; `cell` sizes the facet grid
+    /// (about the largest particle diameter).
+    pub fn new(
+        name: &str,
+        material: usize,
+        vertices: Vec<Point3<Real>>,
+        triangles: Vec<[u32; 3]>,
+        cell: Real,
+    ) -> Self {
+        let grid = FacetGrid::new(&vertices, &triangles, cell);
+        Wall {
+            name: name.to_string(),
+            material,
+            vertices,
+            triangles,
+            pose: Isometry3::identity(),
+            velocity: Vector3::zeros(),
+            angular_velocity: Vector3::zeros(),
+            grid,
+            force: Vector3::zeros(),
+            torque: Vector3::zeros(),
+        }
+    }
+
+    /// Facet `f` in world coordinates.
+    pub fn facet_world(&self, f: usize) -> [Point3<Real>; 3] {
+        self.triangles[f].map(|v| self.pose * self.vertices[v as usize])
+    }
+
+    /// Velocity of the wall material at world point `x`.
+    pub fn velocity_at(&self, x: &Point3<Real>) -> Vector3<Real> {
+        self.velocity
+            + self
+                .angular_velocity
+                .cross(&(x - Point3::from(self.pose.translation.vector)))
+    }
+}
+
+/// Uniform grid over a wall's facets, in the wall frame: each cell lists the facets
+/// whose bounding box meets it.
+#[derive(Clone, Debug, Default)]
+pub struct FacetGrid {
+    origin: Vector3<Real>,
+    cell: Real,
+    dims: [usize; 3],
+    starts: Vec<u32>,
+    facets: Vec<u32>,
+}
+
+impl FacetGrid {
+    /// Builds the grid (cell edge `cell`, coarsened if the mesh is very large).
+    pub fn new(vertices: &[Point3<Real>], triangles: &[[u32; 3]], cell: Real) -> Self {
+        let (lo, hi) = vertices.iter().fold(
+            (
+                Vector3::repeat(Real::INFINITY),
+                Vector3::repeat(Real::NEG_INFINITY),
+            ),
+            |(lo, hi), p| (lo.inf(&p.coords), hi.sup(&p.coords)),
+        );
+        if triangles.is_empty() {
+            return FacetGrid::default();
+        }
+        let mut cell = cell.max(Real::MIN_POSITIVE);
+        let count = |cell: Real| (hi - lo).map(|e| (e / cell).floor() + 1.0);
+        while count(cell).product() > (1 << 22) as Real {
+            cell *= 2.0;
+        }
+        let d = count(cell);
+        let dims = [d.x as usize, d.y as usize, d.z as usize];
+        let mut grid = FacetGrid {
+            origin: lo,
+            cell,
+            dims,
+            starts: vec![0; dims.iter().product::<usize>() + 1],
+            facets: Vec::new(),
+        };
+        let boxes: Vec<([usize; 3], [usize; 3])> = triangles
+            .iter()
+            .map(|t| {
+                let pts = t.map(|v| vertices[v as usize].coords);
+                let a = pts[0].inf(&pts[1]).inf(&pts[2]);
+                let b = pts[0].sup(&pts[1]).sup(&pts[2]);
+                (grid.coords(&a), grid.coords(&b))
+            })
+            .collect();
+        for (a, b) in &boxes {
+            grid.for_cells(*a, *b, |c, starts| starts[c + 1] += 1);
+        }
+        for c in 0..grid.starts.len() - 1 {
+            grid.starts[c + 1] += grid.starts[c];
+        }
+        let mut fill = grid.starts.clone();
+        grid.facets = vec![0; *grid.starts.last().unwrap_or(&0) as usize];
+        for (f, (a, b)) in boxes.iter().enumerate() {
+            let mut cells = Vec::new();
+            grid.for_cells(*a, *b, |c, _| cells.push(c));
+            for c in cells {
+                grid.facets[fill[c] as usize] = f as u32;
+                fill[c] += 1;
+            }
+        }
+        grid
+    }
+
+    fn coords(&self, p: &Vector3<Real>) -> [usize; 3] {
+        let mut c = [0; 3];
+        for k in 0..3 {
+            let x = ((p[k] - self.origin[k]) / self.cell).floor();
+            c[k] = (x.max(0.0) as usize).min(self.dims[k] - 1);
+        }
+        c
+    }
+
+    fn for_cells(&mut self, a: [usize; 3], b: [usize; 3], mut f: impl FnMut(usize, &mut Vec<u32>)) {
+        for z in a[2]..=b[2] {
+            for y in a[1]..=b[1] {
+                for x in a[0]..=b[0] {
+                    let c = (z * self.dims[1] + y) * self.dims[0] + x;
+                    f(c, &mut self.starts);
+                }
+            }
+        }
+    }
+
+    /// Facets whose bounding boxes may meet the ball (`centre`, `radius`) given in the
+    /// wall frame, sorted and without repeats.
+    pub fn query(&self, centre: &Point3<Real>, radius: Real, out: &mut Vec<u32>) {
+        out.clear();
+        if self.dims == [0; 3] {
+            return;
+        }
+        let lo = centre.coords - Vector3::repeat(radius);
+        let hi = centre.coords + Vector3::repeat(radius);
+        // Entirely outside the mesh's box: nothing.
+        let top = self.origin + Vector3::from(self.dims.map(|d| d as Real)) * self.cell;
+        if (0..3).any(|k| hi[k] < self.origin[k] || lo[k] > top[k]) {
+            return;
+        }
+        let (a, b) = (self.coords(&lo), self.coords(&hi));
+        for z in a[2]..=b[2] {
+            for y in a[1]..=b[1] {
+                for x in a[0]..=b[0] {
+                    let c = (z * self.dims[1] + y) * self.dims[0] + x;
+                    out.extend_from_slice(
+                        &self.facets[self.starts[c] as usize..self.starts[c + 1] as usize],
+                    );
+                }
+            }
+        }
+        out.sort_unstable();
+        out.dedup();
+    }
+}

@@ -1,0 +1,199 @@
+//! The CPU engine on small scenes: a particle at rest on a wall carries its weight with
+//! the static overlap the volume law predicts; an edge impact on a wall rebounds with
+//! the requested restitution; results do not depend on the number of threads.
+
+use nalgebra::{Point3, UnitQuaternion, Vector3};
+use talus::contact::Material;
+use talus::engine::step::Engine;
+use talus::geometry::{Shape, generators};
+use talus::world::{BodyType, Wall, World};
+
+fn material(e: f64, friction: f64) -> Material {
+    Material {
+        name: "glass".into(),
+        density: 2500.0,
+        young: 1e8,
+        poisson: 0.25,
+        restitution: e,
+        friction,
+    }
+}
+
+/// A square floor z = 0 of side `side`, split into `n × n` cells of two triangles.
+fn floor(side: f64, n: usize, cell: f64) -> Wall {
+    let mut vertices = Vec::new();
+    for i in 0..=n {
+        for j in 0..=n {
+            vertices.push(Point3::new(
+                -side / 2.0 + side * i as f64 / n as f64,
+                -side / 2.0 + side * j as f64 / n as f64,
+                0.0,
+            ));
+        }
+    }
+    let id = |i: usize, j: usize| (i * (n + 1) + j) as u32;
+    let mut triangles = Vec::new();
+    for i in 0..n {
+        for j in 0..n {
+            triangles.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+            triangles.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+        }
+    }
+    Wall::new("floor", 0, vertices, triangles, cell)
+}
+
+fn world_with(shape: Shape, e: f64, friction: f64, gravity: f64) -> World {
+    let m = material(e, friction);
+    World {
+        body_types: vec![BodyType::new(shape, &m, 0)],
+        materials: vec![m],
+        walls: vec![floor(0.2, 8, 0.02)],
+        gravity: Vector3::new(0.0, 0.0, -gravity),
+        ..World::default()
+    }
+}
+
+/// A sphere's cap overlap gives F ∝ δ^{5/3}: κ A V^{1/3} with A = π(2rδ − δ²) and
+/// V = πδ²(3r − δ)/3.
+#[test]
+fn sphere_at_rest_on_a_floor_carries_its_weight() {
+    let r = 0.005;
+    let mut world = world_with(
+        Shape::Sphere(talus::geometry::Sphere::new(r).unwrap()),
+        0.3,
+        0.5,
+        9.81,
+    );
+    world.particles.push(
+        0,
+        Point3::new(0.003, -0.002, r + 1e-4),
+        UnitQuaternion::identity(),
+        1,
+    );
+    let mut engine = Engine::new(1e-5);
+    engine.initialise(&mut world);
+    for _ in 0..30_000 {
+        engine.step(&mut world);
+    }
+    let t = &world.body_types[0];
+    let v = world.particles.velocity[0].norm();
+    assert!(v < 1e-5, "still moving at {v}");
+    let weight = t.mass * 9.81;
+    // Solve κ A(δ) V(δ)^{1/3} = m g for δ (κ = 2 E*/R, E* = E/2 for equal materials).
+    let kappa = 1e8 / r;
+    let force = |d: f64| {
+        let a = std::f64::consts::PI * (2.0 * r * d - d * d);
+        let v = std::f64::consts::PI * d * d * (3.0 * r - d) / 3.0;
+        kappa * a * v.cbrt()
+    };
+    let (mut lo, mut hi) = (0.0, r);
+    for _ in 0..100 {
+        let mid = 0.5 * (lo + hi);
+        if force(mid) < weight {
+            lo = mid
+        } else {
+            hi = mid
+        }
+    }
+    let sunk = r - world.particles.position[0].z;
+    assert!((sunk - lo).abs() < 1e-3 * lo, "sunk {sunk:e} vs {lo:e}");
+    assert!((world.walls[0].force.z + weight).abs() < 1e-6 * weight);
+    assert!(world.walls[0].force.x.abs() < 1e-9 * weight);
+}
+
+#[test]
+fn edge_impact_on_a_wall_rebounds_with_the_requested_restitution() {
+    let a = 0.01;
+    for e in [0.2, 0.7] {
+        let mut world = world_with(
+            Shape::Polyhedron(generators::cuboid(a, a, a).unwrap().into()),
+            e,
+            0.0,
+            0.0,
+        );
+        let q =
+            UnitQuaternion::from_scaled_axis(Vector3::new(std::f64::consts::FRAC_PI_4, 0.0, 0.0));
+        world.particles.push(
+            0,
+            Point3::new(0.0, 0.0, 0.5 * a * std::f64::consts::SQRT_2 + 1e-5),
+            q,
+            1,
+        );
+        world.particles.velocity[0] = Vector3::new(0.0, 0.0, -0.5);
+        let mut engine = Engine::new(5e-8);
+        engine.initialise(&mut world);
+        let mut touched = false;
+        for _ in 0..400_000 {
+            engine.step(&mut world);
+            touched |= engine.contacts > 0;
+            if touched && engine.contacts == 0 {
+                break;
+            }
+        }
+        let v = world.particles.velocity[0];
+        assert!(touched && engine.contacts == 0);
+        assert!(
+            (v.z / 0.5 - e).abs() < 0.02 * e,
+            "e = {e}: realised {}",
+            v.z / 0.5
+        );
+        // A centred edge impact does not spin the cube.
+        assert!(world.angular_velocity(0).norm() < 1e-6);
+    }
+}
+
+#[test]
+fn results_do_not_depend_on_the_number_of_threads() {
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            let shape = Shape::Polyhedron(generators::dodecahedron(0.005).unwrap().into());
+            let mut world = world_with(shape, 0.5, 0.5, 9.81);
+            world.materials[0].young = 1e7;
+            let mut id = 0;
+            for i in 0..5 {
+                for j in 0..5 {
+                    for k in 0..4 {
+                        let q = UnitQuaternion::from_scaled_axis(Vector3::new(
+                            i as f64,
+                            j as f64 * 0.7,
+                            k as f64 * 1.3,
+                        ));
+                        let p = Point3::new(
+                            -0.02 + 0.009 * i as f64,
+                            -0.02 + 0.009 * j as f64,
+                            0.0052 + 0.009 * k as f64,
+                        );
+                        world.particles.push(0, p, q, id);
+                        id += 1;
+                    }
+                }
+            }
+            let mut engine = Engine::new(1e-5);
+            engine.initialise(&mut world);
+            for _ in 0..3000 {
+                engine.step(&mut world);
+            }
+            assert!(
+                world
+                    .particles
+                    .position
+                    .iter()
+                    .all(|p| p.coords.iter().all(|x| x.is_finite()))
+            );
+            (
+                world.particles.position.clone(),
+                world.particles.angular_momentum.clone(),
+                engine.contacts,
+            )
+        })
+    };
+    let one = run(1);
+    assert!(one.2 > 20, "the particles pile up ({} contacts)", one.2);
+    let two = run(2);
+    assert_eq!(one.0, two.0);
+    assert_eq!(one.1, two.1);
+}
