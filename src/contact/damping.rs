@@ -3,11 +3,11 @@
 use crate::Real;
 
 /// Smallest and largest force exponent `p` of the volume law (face on face: 1/3;
-/// vertex on face: 3).
+/// vertex on face: 3, or 5 in the regularised range).
 const P_MIN: Real = 1.0 / 3.0;
-const P_MAX: Real = 3.0;
+const P_MAX: Real = 5.0;
 /// Number of table nodes in `p`.
-const NODES: usize = 13;
+const NODES: usize = 21;
 
 /// The damping ratio `ζ(p)` that realises one restitution coefficient `e` for contact
 /// forces growing as `δ^p`, tabulated over `p ∈ [1/3, 3]` (linear interpolation).

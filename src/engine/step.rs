@@ -193,6 +193,16 @@ impl Engine {
     }
 }
 
+/// Below this fraction of the smaller equivalent radius, cubed, the volume law is
+/// continued quadratically (see [`crate::contact::normal_force`]): it bounds the
+/// stiffness of flat contacts.
+pub const REGULARISATION_LENGTH: Real = 1e-2;
+
+/// The regularisation volume of a contact whose smaller body has equivalent radius `r`.
+fn regularisation_volume(r: Real) -> Real {
+    (REGULARISATION_LENGTH * r).powi(3)
+}
+
 /// Restitution of a pair of materials.
 fn pair_restitution(a: Real, b: Real) -> Real {
     0.5 * (a + b)
@@ -287,6 +297,7 @@ fn contact_force(
     damping: &DampingTable,
     friction: Real,
     history: Vector3<Real>,
+    regularisation: Real,
     dt: Real,
 ) -> ContactForce {
     let effective_mass = 1.0 / inverse_mass;
@@ -299,6 +310,7 @@ fn contact_force(
             relative_velocity,
             effective_mass,
             stiffness: stiffness.normal,
+            regularisation,
             dt,
         },
         damping,
@@ -363,6 +375,11 @@ fn pair_force(
         &table,
         0.5 * (mi.friction + mj.friction),
         h,
+        regularisation_volume(
+            ti.shape
+                .equivalent_radius()
+                .min(tj.shape.equivalent_radius()),
+        ),
         dt,
     ))
 }
@@ -475,6 +492,7 @@ fn wall_contacts(
                 &table,
                 0.5 * (pm.friction + wm.friction),
                 h,
+                regularisation_volume(t.shape.equivalent_radius()),
                 dt,
             );
             out.push((w as u32, wall_key, c));
