@@ -134,6 +134,26 @@ proptest! {
         }
         let expected = -o.area_vector();
         prop_assert!((grad - expected).norm() <= 1e-5 * o.area + 1e-12, "fd {grad} vs {expected}");
+        // Rotating B about its centroid, and A about its own (= turning B's pose about
+        // A's origin the other way).
+        let (mut rot_b, mut rot_a) = (Vector3::zeros(), Vector3::zeros());
+        for k in 0..3 {
+            let mut w = Vector3::zeros();
+            w[k] = h / 0.01;
+            let turn = |w: Vector3<f64>| nalgebra::UnitQuaternion::from_scaled_axis(w);
+            let spin_b = |w: Vector3<f64>| Isometry3::from_parts(rel.translation, turn(w) * rel.rotation);
+            let vol = |p: &Isometry3<f64>| overlap(&a, &b, p).map_or(0.0, |o| o.volume);
+            rot_b[k] = (vol(&spin_b(w)) - vol(&spin_b(-w))) / (2.0 * w[k]);
+            let spin_a = |w: Vector3<f64>| Isometry3::from_parts(nalgebra::Translation3::identity(), turn(-w)) * rel;
+            rot_a[k] = (vol(&spin_a(w)) - vol(&spin_a(-w))) / (2.0 * w[k]);
+        }
+        let scale = o.area * 0.01;
+        prop_assert!((rot_b - o.rotation_gradient_b).norm() <= 1e-4 * scale + 1e-14, "fd {rot_b} vs {}", o.rotation_gradient_b);
+        prop_assert!((rot_a - o.rotation_gradient_a).norm() <= 1e-4 * scale + 1e-14, "fd {rot_a} vs {}", o.rotation_gradient_a);
+        // Angular momentum balance: the torques and the force's moment cancel.
+        let t = rel.translation.vector;
+        let balance = o.rotation_gradient_a + o.rotation_gradient_b + t.cross(&expected);
+        prop_assert!(balance.norm() <= 1e-9 * scale, "{balance}");
     }
 }
 

@@ -26,7 +26,7 @@ pub struct TangentialForce {
 ///   `c_t` (N s/m), `limit` the Coulomb cap `μ |F_n|`.
 ///
 /// When the trial force exceeds the cap the force is the cap along the trial
-/// direction and the history is shortened to the spring length that gives it.
+/// direction and the history is set to the spring length that alone gives it.
 pub fn tangential_force(
     history: &Vector3<Real>,
     normal: &Vector3<Real>,
@@ -54,9 +54,12 @@ pub fn tangential_force(
         };
     }
     let force = trial * (limit / magnitude);
-    // The spring that alone would give the capped force.
+    // The spring that alone gives the capped force. (Folding the dashpot's share into
+    // the spring, as `-(F + c v_t)/k`, would store a spring pointing along the motion
+    // whenever the dashpot exceeds the cap, and push the bodies on when they stop
+    // sliding: energy from nothing.)
     let history = if stiffness > 0.0 {
-        -(force + damping * vt) / stiffness
+        -force / stiffness
     } else {
         Vector3::zeros()
     };

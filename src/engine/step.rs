@@ -25,14 +25,28 @@ struct ContactGeometry {
     depth: Real,
     normal: Vector3<Real>,
     point: Point3<Real>,
+    /// Derivative of the volume with respect to rotating body 2 about its centroid,
+    /// where the kernel provides it (polyhedra): the elastic torque then derives from
+    /// the same potential as the force.
+    rotation_gradient: Option<Vector3<Real>>,
 }
 
-/// The force one contact puts on its second body, at its contact point.
+/// The force and torque one contact puts on its second body; the first body gets the
+/// opposite force and the torque that balances angular momentum.
 #[derive(Clone, Copy, Debug)]
 struct ContactForce {
     force: Vector3<Real>,
-    point: Point3<Real>,
+    /// Torque on body 2 about its centroid.
+    torque: Vector3<Real>,
     history: Vector3<Real>,
+}
+
+impl ContactForce {
+    /// Torque on body 1 about `x1`, given body 2's centroid `x2`: what keeps the
+    /// pair's angular momentum.
+    fn reaction_torque(&self, x1: &Point3<Real>, x2: &Point3<Real>) -> Vector3<Real> {
+        -(self.torque + (x2 - x1).cross(&self.force))
+    }
 }
 
 /// Key of a particle–wall contact patch: particle id, wall, and the patch plane
@@ -161,8 +175,8 @@ impl Engine {
             let p = &mut world.particles;
             p.force[j] += c.force;
             p.force[i] -= c.force;
-            p.torque[j] += (c.point - p.position[j]).cross(&c.force);
-            p.torque[i] -= (c.point - p.position[i]).cross(&c.force);
+            p.torque[j] += c.torque;
+            p.torque[i] += c.reaction_torque(&p.position[i], &p.position[j]);
             next_history.insert((p.id[i], p.id[j]), c.history);
         }
         self.history = next_history;
@@ -180,11 +194,11 @@ impl Engine {
                 contacts += 1;
                 let p = &mut world.particles;
                 p.force[i] += c.force;
-                p.torque[i] += (c.point - p.position[i]).cross(&c.force);
+                p.torque[i] += c.torque;
                 let wall = &mut world.walls[wall as usize];
                 wall.force -= c.force;
-                wall.torque -=
-                    (c.point - Point3::from(wall.pose.translation.vector)).cross(&c.force);
+                let reference = Point3::from(wall.pose.translation.vector);
+                wall.torque += c.reaction_torque(&reference, &p.position[i]);
                 next_wall_history.insert(key, c.history);
             }
         }
@@ -256,6 +270,7 @@ fn pair_geometry(world: &World, i: usize, j: usize) -> Option<ContactGeometry> {
                 depth: o.depth,
                 normal: pi.rotation * o.normal,
                 point: pi * o.centroid,
+                rotation_gradient: Some(pi.rotation * o.rotation_gradient_b),
             })
         }
         (Shape::Sphere(a), Shape::Sphere(b)) => {
@@ -266,6 +281,7 @@ fn pair_geometry(world: &World, i: usize, j: usize) -> Option<ContactGeometry> {
                 depth: c.depth,
                 normal: c.normal,
                 point: p.position[i] + c.point.coords,
+                rotation_gradient: None,
             })
         }
         (Shape::Polyhedron(a), Shape::Sphere(b)) => {
@@ -277,11 +293,15 @@ fn pair_geometry(world: &World, i: usize, j: usize) -> Option<ContactGeometry> {
                 depth: c.depth,
                 normal: pi.rotation * c.normal,
                 point: pi * c.point,
+                rotation_gradient: None,
             })
         }
         (Shape::Sphere(_), Shape::Polyhedron(_)) => {
+            // Body 2 here is the polyhedron's partner sphere: the cap model's point lies
+            // on the line through the sphere's centre, so it carries no torque model.
             let mut g = pair_geometry(world, j, i)?;
             g.normal = -g.normal;
+            g.rotation_gradient = None;
             Some(g)
         }
     }
@@ -298,6 +318,7 @@ fn contact_force(
     friction: Real,
     history: Vector3<Real>,
     regularisation: Real,
+    centre: &Point3<Real>,
     dt: Real,
 ) -> ContactForce {
     let effective_mass = 1.0 / inverse_mass;
@@ -326,9 +347,19 @@ fn contact_force(
         ct,
         friction * normal.force.norm(),
     );
+    let force = normal.force + t.force;
+    let torque = match g.rotation_gradient {
+        // Elastic part from the potential (U' = elastic / area); damping and friction,
+        // measured at the contact point, act there.
+        Some(rotation) if g.area > 0.0 => {
+            let elastic = g.normal * normal.elastic;
+            -(normal.elastic / g.area) * rotation + (g.point - centre).cross(&(force - elastic))
+        }
+        _ => (g.point - centre).cross(&force),
+    };
     ContactForce {
-        force: normal.force + t.force,
-        point: g.point,
+        force,
+        torque,
         history: t.history,
     }
 }
@@ -380,6 +411,7 @@ fn pair_force(
                 .equivalent_radius()
                 .min(tj.shape.equivalent_radius()),
         ),
+        &p.position[j],
         dt,
     ))
 }
@@ -430,6 +462,7 @@ fn wall_contacts(
                             // The force on the particle is along −∇V: out of the wall.
                             normal: -(pose.rotation * o.volume_gradient) / area,
                             point: pose * o.centroid,
+                            rotation_gradient: Some(pose.rotation * o.rotation_gradient),
                         }
                     })
                 }
@@ -440,6 +473,7 @@ fn wall_contacts(
                         depth: c.depth,
                         normal: c.normal,
                         point: c.point,
+                        rotation_gradient: None,
                     })
                 }
             };
@@ -458,6 +492,10 @@ fn wall_contacts(
                         acc.normal = sum / acc.area;
                         acc.volume = v;
                         acc.depth = acc.depth.max(g.depth);
+                        acc.rotation_gradient = acc
+                            .rotation_gradient
+                            .zip(g.rotation_gradient)
+                            .map(|(a, b)| a + b);
                     }
                     // Spheres: the deepest facet of a flat patch is the plane contact.
                     Shape::Sphere(_) => {
@@ -493,6 +531,7 @@ fn wall_contacts(
                 0.5 * (pm.friction + wm.friction),
                 h,
                 regularisation_volume(t.shape.equivalent_radius()),
+                &p.position[i],
                 dt,
             );
             out.push((w as u32, wall_key, c));

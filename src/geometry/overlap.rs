@@ -45,7 +45,7 @@ use std::cell::RefCell;
 use nalgebra::{Point3, Vector3};
 
 use super::gjk::{self, GjkResult};
-use super::polygon::{ConeSums, FixedPolygon, clip_by_plane, vector_area};
+use super::polygon::{ConeSums, FixedPolygon, area_moment, clip_by_plane, vector_area};
 use super::sphere::closest_point_on_triangle;
 use super::{ConvexPolyhedron, Plane, Pose};
 use crate::Real;
@@ -71,6 +71,14 @@ pub struct OverlapGeometry {
     /// Extent of the intersection along the normal (the penetration depth of a flat
     /// contact).
     pub depth: Real,
+    /// Derivative of the volume with respect to rotating A about its centroid (A's
+    /// frame): the elastic torque on A is `−U'(V)` times it. With the normal force
+    /// along the area vector this makes the contact exactly conservative; a force
+    /// applied at the volume centroid would not be.
+    pub rotation_gradient_a: Vector3<Real>,
+    /// Derivative of the volume with respect to rotating B about its centroid (A's
+    /// frame).
+    pub rotation_gradient_b: Vector3<Real>,
 }
 
 impl OverlapGeometry {
@@ -161,7 +169,7 @@ pub fn overlap_with(
     s.starts.clear();
     s.starts.push(0);
     if a.face_count() <= MASK_MAX_FACES && b.face_count() <= MASK_MAX_FACES {
-        overlap_masked(a, b, s)
+        overlap_masked(a, b, &t, s)
     } else {
         overlap_culled(a, b, b_in_a, s)
     }
@@ -346,6 +354,7 @@ fn live_planes(out: &[u64], on: &[u64]) -> u64 {
 fn overlap_masked(
     a: &ConvexPolyhedron,
     b: &ConvexPolyhedron,
+    t: &Vector3<Real>,
     s: &mut OverlapScratch,
 ) -> Option<OverlapGeometry> {
     let tol = tolerance(a, b);
@@ -370,8 +379,7 @@ fn overlap_masked(
     faces_reaching_planes(a, &s.out_a, &s.on_a, &mut s.reach_a);
 
     // Faces of A clipped by B.
-    let mut s_a = Vector3::zeros();
-    let mut s_flush = Vector3::zeros();
+    let mut sums = SideSums::default();
     for f in bits(live_a) {
         let face = a.face(f);
         let Some((cut, coplanar)) = face_masks(face, &s.out_a, &s.on_a) else {
@@ -384,10 +392,13 @@ fn overlap_masked(
         clip_by_mask(&mut s.fixed, cut, &s.b_planes);
         if !s.fixed.is_degenerate() {
             let area = vector_area(s.fixed.points());
+            let moment = area_moment(s.fixed.points());
             if flush {
-                s_flush += area
+                sums.flush_area += area;
+                sums.flush_moment += moment;
             } else {
-                s_a += area
+                sums.area += area;
+                sums.moment += moment;
             }
             s.points.extend_from_slice(s.fixed.points());
             s.starts.push(s.points.len() as u32);
@@ -396,7 +407,7 @@ fn overlap_masked(
 
     // Faces of B clipped by A; a face lying in a plane of A of equal orientation is
     // already covered by A's face.
-    let mut s_b = Vector3::zeros();
+    let mut sums_b = SideSums::default();
     for g in bits(live_b) {
         let face = b.face(g);
         let Some((cut, coplanar)) = face_masks(face, &s.out_b, &s.on_b) else {
@@ -410,14 +421,13 @@ fn overlap_masked(
         s.fixed.set(face.iter().map(|&v| s.b_points[v as usize]));
         clip_by_mask(&mut s.fixed, cut, a.planes());
         if !s.fixed.is_degenerate() {
-            s_b += vector_area(s.fixed.points());
+            sums_b.area += vector_area(s.fixed.points());
+            sums_b.moment += area_moment(s.fixed.points());
             s.points.extend_from_slice(s.fixed.points());
             s.starts.push(s.points.len() as u32);
         }
     }
-    // With flush pieces F left out of S_A: S_A + F + S_B = 0 on the closed surface,
-    // and the area vector without F from either side is S_A = −(S_B + F).
-    summarise(&s.points, &s.starts, s_a - s_b - s_flush)
+    summarise(&s.points, &s.starts, &sums, &sums_b, t)
 }
 
 /// Clips a face polygon by the planes in `cut`.
@@ -537,7 +547,7 @@ fn overlap_culled(
         points,
         starts,
     };
-    let (s_a, s_flush) = clip_faces_locally(
+    let sums = clip_faces_locally(
         LocalSide {
             shape: a,
             points: a.vertices(),
@@ -559,7 +569,7 @@ fn overlap_culled(
         false,
         &mut out,
     );
-    let (s_b, _) = clip_faces_locally(
+    let sums_b = clip_faces_locally(
         LocalSide {
             shape: b,
             points: b_points,
@@ -581,7 +591,7 @@ fn overlap_culled(
         true,
         &mut out,
     );
-    summarise(out.points, out.starts, s_a - s_b - s_flush)
+    summarise(out.points, out.starts, &sums, &sums_b, &t)
 }
 
 /// One shape as seen by the culled path, everything in A's frame.
@@ -648,8 +658,7 @@ struct LocalClipOutput<'a> {
 /// `S_f` around face f, the other solid (if it meets `S_f ∩ R`) is bounded by the
 /// planes of its faces that meet that ball, so only those cut f (besides R itself). The
 /// sphere tests are conservative, so a non-empty piece is kept only if its centroid
-/// lies in the other solid. Returns the summed vector areas of the pieces (not flush,
-/// flush).
+/// lies in the other solid. Returns the sums over the pieces.
 fn clip_faces_locally(
     own: LocalSide,
     other: LocalSide,
@@ -657,9 +666,8 @@ fn clip_faces_locally(
     tol: Real,
     drop_coplanar: bool,
     out: &mut LocalClipOutput,
-) -> (Vector3<Real>, Vector3<Real>) {
-    let mut area = Vector3::zeros();
-    let mut flush_area = Vector3::zeros();
+) -> SideSums {
+    let mut sums = SideSums::default();
     let inside_tol = 1e3 * tol;
     // The other side's faces sorted along the axis of their widest spread, so that
     // each face finds its neighbours in a window instead of a full scan.
@@ -736,15 +744,18 @@ fn clip_faces_locally(
             }
         }
         let piece = vector_area(out.poly);
+        let moment = area_moment(out.poly);
         if flush {
-            flush_area += piece;
+            sums.flush_area += piece;
+            sums.flush_moment += moment;
         } else {
-            area += piece;
+            sums.area += piece;
+            sums.moment += moment;
         }
         out.points.extend_from_slice(out.poly);
         out.starts.push(out.points.len() as u32);
     }
-    (area, flush_area)
+    sums
 }
 
 /// Decides how a face (its points and normal) meets the other solid's candidate
@@ -817,11 +828,28 @@ fn box_planes(lo: &Vector3<Real>, hi: &Vector3<Real>) -> [Plane; 6] {
     ]
 }
 
-/// Volume, centroid and extent of the closed polygon set; `twice_area` is `S_A − S_B`.
+/// Vector areas and their moments (about A's origin) of one shape's clipped pieces.
+#[derive(Clone, Copy, Debug, Default)]
+struct SideSums {
+    area: Vector3<Real>,
+    moment: Vector3<Real>,
+    /// Pieces lying flush against a face of the other shape (A's side only).
+    flush_area: Vector3<Real>,
+    flush_moment: Vector3<Real>,
+}
+
+/// Volume, centroid, extent and gradients of the closed polygon set. `t` is B's
+/// centroid in A's frame.
+///
+/// Flush pieces F are left out of A's sums and counted with B's (as B's coincident,
+/// dropped face): on the closed surface `S_A + F + S_B = 0`, and the area vector is
+/// `S_A = −(S_B + F)` from either side.
 fn summarise(
     points: &[Point3<Real>],
     starts: &[u32],
-    twice_area: Vector3<Real>,
+    a: &SideSums,
+    b: &SideSums,
+    t: &Vector3<Real>,
 ) -> Option<OverlapGeometry> {
     if points.is_empty() {
         return None;
@@ -840,6 +868,8 @@ fn summarise(
     if !(volume > 0.0) {
         return None;
     }
+    let s_b = b.area + a.flush_area;
+    let twice_area = a.area - s_b;
     let area = 0.5 * twice_area.norm();
     // A shape inside another (or two coincident ones) has a vanishing area vector: the
     // overlap volume is stationary, and the normal is only a convention.
@@ -860,6 +890,8 @@ fn summarise(
         normal,
         area,
         depth: hi - lo,
+        rotation_gradient_a: a.moment,
+        rotation_gradient_b: b.moment + a.flush_moment - t.cross(&s_b),
     })
 }
 

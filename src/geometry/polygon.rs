@@ -82,6 +82,21 @@ pub(crate) fn vector_area(poly: &[Point3<Real>]) -> Vector3<Real> {
     0.5 * s
 }
 
+/// First moment of a planar polygon's vector area about the origin: `Σ ȳ × a` over
+/// its fan triangles (centroid `ȳ`, vector area `a`). Summed over the faces a solid
+/// moves with, it is the derivative of a volume with respect to rotating that solid.
+#[inline]
+pub(crate) fn area_moment(poly: &[Point3<Real>]) -> Vector3<Real> {
+    let mut m = Vector3::zeros();
+    let p0 = poly[0];
+    for k in 1..poly.len().saturating_sub(1) {
+        let a = 0.5 * (poly[k] - p0).cross(&(poly[k + 1] - p0));
+        let centre = (p0.coords + poly[k].coords + poly[k + 1].coords) / 3.0;
+        m += centre.cross(&a);
+    }
+    m
+}
+
 /// Accumulates the signed volume and first moment of the cone from `origin` over
 /// polygons of a closed outward-oriented surface.
 #[derive(Clone, Copy, Debug)]

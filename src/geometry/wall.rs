@@ -26,7 +26,7 @@ use std::cell::RefCell;
 
 use nalgebra::{Point3, Vector3};
 
-use super::polygon::{ConeSums, FixedPolygon, vector_area};
+use super::polygon::{ConeSums, FixedPolygon, area_moment, vector_area};
 use super::sphere::closest_point_on_triangle;
 use super::{ConvexPolyhedron, Plane};
 use crate::Real;
@@ -43,6 +43,9 @@ pub struct FacetOverlap {
     /// force on the particle is `−U'(V) · volume_gradient` (it points out of the
     /// wall).
     pub volume_gradient: Vector3<Real>,
+    /// Gradient of `volume` with respect to rotating the particle about its centroid;
+    /// the elastic torque on the particle is `−U'(V)` times it.
+    pub rotation_gradient: Vector3<Real>,
     /// Deepest penetration of the particle behind the facet plane within the prism.
     pub depth: Real,
     /// Area of the overlap of the facet with the particle's cross-section in the facet
@@ -118,6 +121,7 @@ fn facet_overlap(
 
     // Faces of the particle clipped to the prism.
     let mut grad_p = Vector3::zeros();
+    let mut rot_p = Vector3::zeros();
     for f in 0..poly.face_count() {
         clipped.set(poly.face(f).iter().map(|&v| poly.vertices()[v as usize]));
         for plane in &planes {
@@ -128,6 +132,7 @@ fn facet_overlap(
         }
         if !clipped.is_degenerate() {
             grad_p += vector_area(clipped.points());
+            rot_p += area_moment(clipped.points());
             points.extend_from_slice(clipped.points());
             starts.push(points.len());
         }
@@ -185,6 +190,7 @@ fn facet_overlap(
         centroid: cone.centroid(),
         // ∂V/∂x_P = S_P = −S_Q; average the two for symmetry of round-off.
         volume_gradient: 0.5 * (grad_p - grad_q),
+        rotation_gradient: rot_p,
         depth,
         section_area,
         facet_normal: n,
