@@ -26,7 +26,8 @@ pub struct TangentialForce {
 ///   `c_t` (N s/m), `limit` the Coulomb cap `μ |F_n|`.
 ///
 /// When the trial force exceeds the cap the force is the cap along the trial
-/// direction and the history is set to the spring length that alone gives it.
+/// direction, and the spring is shortened (never lengthened) to the length whose force
+/// is the cap, so that sliding never stores energy in the spring.
 pub fn tangential_force(
     history: &Vector3<Real>,
     normal: &Vector3<Real>,
@@ -54,14 +55,17 @@ pub fn tangential_force(
         };
     }
     let force = trial * (limit / magnitude);
-    // The spring that alone gives the capped force. (Folding the dashpot's share into
-    // the spring, as `-(F + c v_t)/k`, would store a spring pointing along the motion
-    // whenever the dashpot exceeds the cap, and push the bodies on when they stop
-    // sliding: energy from nothing.)
-    let history = if stiffness > 0.0 {
-        -force / stiffness
+    // While sliding the spring is shortened, never lengthened, to what the cap allows:
+    // resetting it to the length that alone gives the capped force would create spring
+    // energy whenever the dashpot carries most of the trial force, and that energy
+    // comes back as a push along the motion when the sliding reverses. (Folding the
+    // dashpot into the spring, `-(F + c v_t)/k`, is worse: the spring then points along
+    // the motion.)
+    let length = spring.norm();
+    let history = if stiffness > 0.0 && stiffness * length > limit {
+        spring * (limit / (stiffness * length))
     } else {
-        Vector3::zeros()
+        spring
     };
     TangentialForce {
         force,
