@@ -263,3 +263,43 @@ fn elastic_frictionless_collisions_conserve_energy() {
         );
     }
 }
+
+/// Regression: resetting the friction spring to the cap's length while a strong
+/// dashpot made the contact slide stored energy that came back as a push (a damped,
+/// frictional pair collision ended with 7 % more kinetic energy than it began with).
+#[test]
+fn damped_frictional_collision_never_gains_energy() {
+    for (e, mu) in [(0.5, 0.5), (0.9, 0.3), (0.2, 1.0)] {
+        let shape = Shape::Polyhedron(generators::dodecahedron(0.005).unwrap().into());
+        let mut world = world_with(shape, e, mu, 0.0);
+        world.materials[0].young = 1e7;
+        world.walls.clear();
+        world.particles.push(
+            0,
+            Point3::new(0.0, 0.0, 0.0065),
+            UnitQuaternion::from_scaled_axis(Vector3::new(1.0, 0.7, 1.3)),
+            1,
+        );
+        let q = UnitQuaternion::from_scaled_axis(Vector3::new(-0.3, 0.2, 0.9));
+        world
+            .particles
+            .push(0, Point3::new(0.0003, 0.0002, 0.0165), q, 2);
+        world.particles.velocity[1] = Vector3::new(0.0, 0.0, -0.5);
+        let mut engine = Engine::new(1e-6);
+        engine.initialise(&mut world);
+        let e0 = world.kinetic_energy();
+        let mut worst: f64 = 0.0;
+        for _ in 0..5_000 {
+            engine.step(&mut world);
+            worst = worst.max(world.kinetic_energy() / e0);
+        }
+        assert!(
+            worst <= 1.0 + 1e-9,
+            "e = {e}, mu = {mu}: kinetic energy reached {worst} of the initial"
+        );
+        assert!(
+            world.kinetic_energy() < 0.99 * e0,
+            "e = {e}, mu = {mu}: the collision dissipates"
+        );
+    }
+}
