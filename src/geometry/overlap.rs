@@ -547,54 +547,29 @@ fn overlap_culled(
         points,
         starts,
     };
-    let sums = clip_faces_locally(
-        LocalSide {
-            shape: a,
-            points: a.vertices(),
-            planes: a.planes(),
-            spheres: a_spheres,
-            ids: a_faces,
-            soa: a_soa,
-        },
-        LocalSide {
-            shape: b,
-            points: b_points,
-            planes: b_planes,
-            spheres: b_spheres,
-            ids: b_faces,
-            soa: b_soa,
-        },
-        &region,
-        tol,
-        false,
-        &mut out,
-    );
-    let sums_b = clip_faces_locally(
-        LocalSide {
-            shape: b,
-            points: b_points,
-            planes: b_planes,
-            spheres: b_spheres,
-            ids: b_faces,
-            soa: b_soa,
-        },
-        LocalSide {
-            shape: a,
-            points: a.vertices(),
-            planes: a.planes(),
-            spheres: a_spheres,
-            ids: a_faces,
-            soa: a_soa,
-        },
-        &region,
-        tol,
-        true,
-        &mut out,
-    );
+    let side_a = LocalSide {
+        shape: a,
+        points: a.vertices(),
+        planes: a.planes(),
+        spheres: a_spheres,
+        ids: a_faces,
+        soa: a_soa,
+    };
+    let side_b = LocalSide {
+        shape: b,
+        points: b_points,
+        planes: b_planes,
+        spheres: b_spheres,
+        ids: b_faces,
+        soa: b_soa,
+    };
+    let sums = clip_faces_locally(side_a, side_b, &region, tol, false, &mut out);
+    let sums_b = clip_faces_locally(side_b, side_a, &region, tol, true, &mut out);
     summarise(out.points, out.starts, &sums, &sums_b, &t)
 }
 
 /// One shape as seen by the culled path, everything in A's frame.
+#[derive(Clone, Copy)]
 struct LocalSide<'a> {
     shape: &'a ConvexPolyhedron,
     points: &'a [Point3<Real>],
