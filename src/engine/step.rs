@@ -2,6 +2,7 @@
 //! forces (in parallel over pairs and over particles), accumulation in a fixed order,
 //! and the closing kick.
 
+use std::borrow::Cow;
 use std::collections::HashMap;
 
 use nalgebra::{Matrix3, Point3, UnitQuaternion, Vector3};
@@ -84,7 +85,6 @@ impl Engine {
 
     /// Computes the forces of the current state (call once before the first step).
     pub fn initialise(&mut self, world: &mut World) {
-        self.prepare_damping(world);
         self.compute_forces(world);
     }
 
@@ -115,8 +115,8 @@ impl Engine {
         self.compute_forces(world);
         let p = &mut world.particles;
         for i in 0..p.len() {
-            let t = &types_of(&world.body_types, p.body_type[i]);
-            p.velocity[i] += p.force[i] * (0.5 * dt / t.0);
+            let mass = world.body_types[p.body_type[i] as usize].mass;
+            p.velocity[i] += p.force[i] * (0.5 * dt / mass);
             p.angular_momentum[i] += p.torque[i] * (0.5 * dt);
         }
     }
@@ -222,9 +222,13 @@ fn pair_restitution(a: Real, b: Real) -> Real {
     0.5 * (a + b)
 }
 
-fn types_of(types: &[crate::world::BodyType], t: u32) -> (Real, Vector3<Real>) {
-    let t = &types[t as usize];
-    (t.mass, t.inertia)
+/// The calibrated damping of restitution `e`: borrowed from the tables prepared for
+/// every material pair, calibrated afresh only for a value that was not prepared.
+fn damping_table(damping: &HashMap<u64, DampingTable>, e: Real) -> Cow<'_, DampingTable> {
+    match damping.get(&e.to_bits()) {
+        Some(table) => Cow::Borrowed(table),
+        None => Cow::Owned(DampingTable::new(e)),
+    }
 }
 
 /// World-frame inverse inertia of particle `i`.
@@ -387,10 +391,7 @@ fn pair_force(
     );
     // The pair's restitution and friction: the means of the two materials'.
     let e = pair_restitution(mi.restitution, mj.restitution);
-    let table = damping
-        .get(&e.to_bits())
-        .cloned()
-        .unwrap_or_else(|| DampingTable::new(e));
+    let table = damping_table(damping, e);
     let rel_v = velocity_at(world, j, &g.point) - velocity_at(world, i, &g.point);
     let inv_m = inverse_mass_at(world, i, &g.point, &g.normal)
         + inverse_mass_at(world, j, &g.point, &g.normal);
@@ -510,10 +511,7 @@ fn wall_contacts(
         let pm = &world.materials[t.material];
         let stiffness = PairStiffness::particle_wall(pm, t.shape.equivalent_radius(), wm);
         let e = pair_restitution(pm.restitution, wm.restitution);
-        let table = damping
-            .get(&e.to_bits())
-            .cloned()
-            .unwrap_or_else(|| DampingTable::new(e));
+        let table = damping_table(damping, e);
         for (key, g) in patches {
             if !(g.area > 0.0) || !g.normal.iter().all(|x| x.is_finite()) {
                 continue;
