@@ -17,6 +17,8 @@
 pub mod contact;
 pub mod engine;
 pub mod geometry;
+pub mod output;
+pub mod scene;
 pub mod world;
 
 /// The scalar type used throughout talus.

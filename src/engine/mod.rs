@@ -7,3 +7,4 @@
 pub mod broad_phase;
 pub mod integrate;
 pub mod step;
+pub mod time_step;

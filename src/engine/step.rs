@@ -5,7 +5,7 @@
 use std::borrow::Cow;
 use std::collections::HashMap;
 
-use nalgebra::{Matrix3, Point3, UnitQuaternion, Vector3};
+use nalgebra::{Matrix3, Point3, Vector3};
 use rayon::prelude::*;
 
 use super::broad_phase::BroadPhase;
@@ -60,6 +60,9 @@ type WallKey = (u64, u32, [i64; 4]);
 pub struct Engine {
     /// Time step.
     pub dt: Real,
+    /// Length, relative to the smaller equivalent radius of a contact, below whose
+    /// cube the volume law is regularised (see [`crate::contact::normal_force`]).
+    pub regularisation_length: Real,
     broad: BroadPhase,
     pairs: Vec<[u32; 2]>,
     history: HashMap<(u64, u64), Vector3<Real>>,
@@ -74,6 +77,7 @@ impl Engine {
     pub fn new(dt: Real) -> Self {
         Engine {
             dt,
+            regularisation_length: REGULARISATION_LENGTH,
             broad: BroadPhase::default(),
             pairs: Vec::new(),
             history: HashMap::new(),
@@ -107,9 +111,7 @@ impl Engine {
             p.angular_momentum[i] = rot.angular_momentum;
         }
         for wall in &mut world.walls {
-            let turn = UnitQuaternion::from_scaled_axis(wall.angular_velocity * dt);
-            wall.pose.translation.vector += wall.velocity * dt;
-            wall.pose.rotation = turn * wall.pose.rotation;
+            wall.advance(world.time, dt);
         }
         world.time += dt;
         self.compute_forces(world);
@@ -146,6 +148,9 @@ impl Engine {
         for wall in &mut world.walls {
             wall.force = Vector3::zeros();
             wall.torque = Vector3::zeros();
+            wall.facet_force
+                .iter_mut()
+                .for_each(|f| *f = Vector3::zeros());
         }
         let radii: Vec<Real> = (0..n)
             .map(|i| {
@@ -160,11 +165,14 @@ impl Engine {
         let w = &*world;
         let history = &self.history;
         let damping = &self.damping;
-        let dt = self.dt;
+        let law = LawParams {
+            dt: self.dt,
+            regularisation_length: self.regularisation_length,
+        };
         let results: Vec<Option<ContactForce>> = self
             .pairs
             .par_iter()
-            .map(|&[i, j]| pair_force(w, i as usize, j as usize, history, damping, dt))
+            .map(|&[i, j]| pair_force(w, i as usize, j as usize, history, damping, &law))
             .collect();
         let mut next_history = HashMap::with_capacity(results.len());
         let mut contacts = 0;
@@ -177,29 +185,44 @@ impl Engine {
             p.force[i] -= c.force;
             p.torque[j] += c.torque;
             p.torque[i] += c.reaction_torque(&p.position[i], &p.position[j]);
-            next_history.insert((p.id[i], p.id[j]), c.history);
+            if c.history != Vector3::zeros() {
+                next_history.insert((p.id[i], p.id[j]), c.history);
+            }
         }
         self.history = next_history;
 
         // Particles against walls, in parallel over particles.
         let w = &*world;
         let wall_history = &self.wall_history;
-        let wall_results: Vec<Vec<(u32, WallKey, ContactForce)>> = (0..n)
+        let wall_results: Vec<Vec<WallContact>> = (0..n)
             .into_par_iter()
-            .map(|i| wall_contacts(w, i, wall_history, damping, dt))
+            .map(|i| wall_contacts(w, i, wall_history, damping, &law))
             .collect();
         let mut next_wall_history = HashMap::new();
         for (i, list) in wall_results.into_iter().enumerate() {
-            for (wall, key, c) in list {
+            for WallContact {
+                wall,
+                key,
+                force: c,
+                facets,
+            } in list
+            {
                 contacts += 1;
                 let p = &mut world.particles;
                 p.force[i] += c.force;
                 p.torque[i] += c.torque;
                 let wall = &mut world.walls[wall as usize];
                 wall.force -= c.force;
-                let reference = Point3::from(wall.pose.translation.vector);
-                wall.torque += c.reaction_torque(&reference, &p.position[i]);
-                next_wall_history.insert(key, c.history);
+                wall.torque += c.reaction_torque(&wall.reference(), &p.position[i]);
+                let total: Real = facets.iter().map(|f| f.1).sum();
+                if total > 0.0 {
+                    for (f, share) in facets {
+                        wall.facet_force[f as usize] -= c.force * (share / total);
+                    }
+                }
+                if c.history != Vector3::zeros() {
+                    next_wall_history.insert(key, c.history);
+                }
             }
         }
         self.wall_history = next_wall_history;
@@ -207,14 +230,24 @@ impl Engine {
     }
 }
 
-/// Below this fraction of the smaller equivalent radius, cubed, the volume law is
-/// continued quadratically (see [`crate::contact::normal_force`]): it bounds the
-/// stiffness of flat contacts.
+/// Default regularisation length: below this fraction of the smaller equivalent
+/// radius, cubed, the volume law is continued quadratically (see
+/// [`crate::contact::normal_force`]); it bounds the stiffness of flat contacts.
 pub const REGULARISATION_LENGTH: Real = 1e-2;
 
-/// The regularisation volume of a contact whose smaller body has equivalent radius `r`.
-fn regularisation_volume(r: Real) -> Real {
-    (REGULARISATION_LENGTH * r).powi(3)
+/// Parameters of the contact law that the engine sets.
+#[derive(Clone, Copy, Debug)]
+struct LawParams {
+    dt: Real,
+    regularisation_length: Real,
+}
+
+impl LawParams {
+    /// The regularisation volume of a contact whose smaller body has equivalent
+    /// radius `r`.
+    fn regularisation_volume(&self, r: Real) -> Real {
+        (self.regularisation_length * r).powi(3)
+    }
 }
 
 /// Restitution of a pair of materials.
@@ -374,7 +407,7 @@ fn pair_force(
     j: usize,
     history: &HashMap<(u64, u64), Vector3<Real>>,
     damping: &HashMap<u64, DampingTable>,
-    dt: Real,
+    law: &LawParams,
 ) -> Option<ContactForce> {
     let g = pair_geometry(world, i, j)?;
     let p = &world.particles;
@@ -407,14 +440,26 @@ fn pair_force(
         &table,
         0.5 * (mi.friction + mj.friction),
         h,
-        regularisation_volume(
+        law.regularisation_volume(
             ti.shape
                 .equivalent_radius()
                 .min(tj.shape.equivalent_radius()),
         ),
         &p.position[j],
-        dt,
+        law.dt,
     ))
+}
+
+/// A patch being assembled: its plane key, summed geometry, and facet shares.
+type Patch = ([i64; 4], ContactGeometry, Vec<(u32, Real)>);
+
+/// One particle–wall contact: a coplanar patch of one wall's facets.
+struct WallContact {
+    wall: u32,
+    key: WallKey,
+    force: ContactForce,
+    /// The patch's facets with their shares of the overlap (volumes).
+    facets: Vec<(u32, Real)>,
 }
 
 /// Contacts of particle `i` with every wall, one per coplanar patch of facets.
@@ -423,8 +468,8 @@ fn wall_contacts(
     i: usize,
     history: &HashMap<WallKey, Vector3<Real>>,
     damping: &HashMap<u64, DampingTable>,
-    dt: Real,
-) -> Vec<(u32, WallKey, ContactForce)> {
+    law: &LawParams,
+) -> Vec<WallContact> {
     let p = &world.particles;
     let t = &world.body_types[p.body_type[i] as usize];
     let radius = t.shape.circumradius();
@@ -441,10 +486,17 @@ fn wall_contacts(
             continue;
         }
         // Patches: facets sharing a plane (to 1e-9 in the normal, 1e-9 R in offset).
-        let mut patches: Vec<([i64; 4], ContactGeometry)> = Vec::new();
+        let mut patches: Vec<Patch> = Vec::new();
         for &f in &facets {
             let tri = wall.facet_world(f as usize);
             let n = (tri[1] - tri[0]).cross(&(tri[2] - tri[0])).normalize();
+            // Walls are one-sided: a particle whose centroid is behind a facet's plane
+            // has passed it (or the mesh faces the wrong way) and is not pushed back
+            // through from behind, where the half-infinite prism would meet it with
+            // its whole volume at once.
+            if n.dot(&(p.position[i] - tri[0])) < 0.0 {
+                continue;
+            }
             let key = [
                 (n.x * 1e9).round() as i64,
                 (n.y * 1e9).round() as i64,
@@ -479,9 +531,9 @@ fn wall_contacts(
                 }
             };
             let Some(g) = g else { continue };
-            match patches.iter_mut().find(|(k, _)| *k == key) {
-                None => patches.push((key, g)),
-                Some((_, acc)) => match &t.shape {
+            match patches.iter_mut().find(|(k, _, _)| *k == key) {
+                None => patches.push((key, g, vec![(f, g.volume)])),
+                Some((_, acc, shares)) => match &t.shape {
                     // Polyhedra: the facets' prisms tile the patch; sum them.
                     Shape::Polyhedron(_) => {
                         let v = acc.volume + g.volume;
@@ -497,11 +549,13 @@ fn wall_contacts(
                             .rotation_gradient
                             .zip(g.rotation_gradient)
                             .map(|(a, b)| a + b);
+                        shares.push((f, g.volume));
                     }
                     // Spheres: the deepest facet of a flat patch is the plane contact.
                     Shape::Sphere(_) => {
                         if g.depth > acc.depth {
                             *acc = g;
+                            *shares = vec![(f, 1.0)];
                         }
                     }
                 },
@@ -512,7 +566,7 @@ fn wall_contacts(
         let stiffness = PairStiffness::particle_wall(pm, t.shape.equivalent_radius(), wm);
         let e = pair_restitution(pm.restitution, wm.restitution);
         let table = damping_table(damping, e);
-        for (key, g) in patches {
+        for (key, g, facets) in patches {
             if !(g.area > 0.0) || !g.normal.iter().all(|x| x.is_finite()) {
                 continue;
             }
@@ -528,11 +582,16 @@ fn wall_contacts(
                 &table,
                 0.5 * (pm.friction + wm.friction),
                 h,
-                regularisation_volume(t.shape.equivalent_radius()),
+                law.regularisation_volume(t.shape.equivalent_radius()),
                 &p.position[i],
-                dt,
+                law.dt,
             );
-            out.push((w as u32, wall_key, c));
+            out.push(WallContact {
+                wall: w as u32,
+                key: wall_key,
+                force: c,
+                facets,
+            });
         }
     }
     out

@@ -30,6 +30,7 @@ mod polyhedron;
 mod shape;
 mod spec;
 pub mod sphere;
+pub mod surfaces;
 mod trimesh;
 pub mod wall;
 

@@ -1,10 +1,14 @@
 //! The state of a DEM world in flat arrays: particles (structure of arrays), body
 //! types (shape and material, stored once), materials, and triangulated walls.
 
+mod inlet;
+mod motion;
 mod walls;
 
 use nalgebra::{Point3, UnitQuaternion, Vector3};
 
+pub use inlet::{Inlet, PLACEMENT_ATTEMPTS, is_free, random_orientation};
+pub use motion::{MotionKey, WallMotion, WallVelocity, advance_pose};
 pub use walls::{FacetGrid, Wall};
 
 use crate::Real;

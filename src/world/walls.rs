@@ -1,7 +1,8 @@
 //! Triangulated walls and the grid that finds their facets near a point.
 
-use nalgebra::{Isometry3, Point3, Vector3};
+use nalgebra::{Isometry3, Point3, Translation3, Vector3};
 
+use super::motion::{WallMotion, WallVelocity, advance_pose};
 use crate::Real;
 
 /// A rigid triangulated wall. Its mesh is stored in the wall's own frame; `pose` places
@@ -28,6 +29,11 @@ pub struct Wall {
     pub force: Vector3<Real>,
     /// Torque the particles exert about the wall frame's origin.
     pub torque: Vector3<Real>,
+    /// Force on each facet in the current step (a patch's force shared by the
+    /// facets' overlap volumes).
+    pub facet_force: Vec<Vector3<Real>>,
+    /// How the wall moves.
+    pub motion: WallMotion,
 }
 
 impl Wall {
@@ -41,6 +47,7 @@ impl Wall {
         cell: Real,
     ) -> Self {
         let grid = FacetGrid::new(&vertices, &triangles, cell);
+        let n_facets = triangles.len();
         Wall {
             name: name.to_string(),
             material,
@@ -52,7 +59,58 @@ impl Wall {
             grid,
             force: Vector3::zeros(),
             torque: Vector3::zeros(),
+            facet_force: vec![Vector3::zeros(); n_facets],
+            motion: WallMotion::Fixed,
         }
+    }
+
+    /// Puts the wall's reference point (its frame origin, about which torque is
+    /// reported and rotation happens) at the world point `reference`; the mesh stays
+    /// where it is.
+    pub fn with_reference(mut self, reference: Point3<Real>) -> Self {
+        let shift = Isometry3::from_parts(Translation3::from(reference.coords), self.pose.rotation);
+        let to_new = shift.inverse() * self.pose;
+        for v in &mut self.vertices {
+            *v = to_new * *v;
+        }
+        self.pose = shift;
+        self.grid = FacetGrid::new(&self.vertices, &self.triangles, self.grid.cell);
+        self
+    }
+
+    /// Sets the wall's motion (and its velocities at time 0).
+    pub fn with_motion(mut self, motion: WallMotion) -> Self {
+        self.motion = motion;
+        self.set_velocity_at(0.0);
+        self
+    }
+
+    /// The wall's reference point in the world.
+    pub fn reference(&self) -> Point3<Real> {
+        Point3::from(self.pose.translation.vector)
+    }
+
+    /// Sets the velocities the motion prescribes at time `t` (external motion keeps
+    /// what was set).
+    pub fn set_velocity_at(&mut self, t: Real) {
+        if let Some(v) = self.motion.velocity(t) {
+            self.velocity = v.linear;
+            self.angular_velocity = v.angular;
+        }
+    }
+
+    /// Moves the wall from time `t` to `t + dt`: the pose by the velocities at the
+    /// middle of the step, and the velocities to their values at the end.
+    pub fn advance(&mut self, t: Real, dt: Real) {
+        if self.motion.is_fixed() {
+            return;
+        }
+        let mid = self.motion.velocity(t + 0.5 * dt).unwrap_or(WallVelocity {
+            linear: self.velocity,
+            angular: self.angular_velocity,
+        });
+        advance_pose(&mut self.pose, &mid, dt);
+        self.set_velocity_at(t + dt);
     }
 
     /// Facet `f` in world coordinates.
@@ -62,10 +120,7 @@ impl Wall {
 
     /// Velocity of the wall material at world point `x`.
     pub fn velocity_at(&self, x: &Point3<Real>) -> Vector3<Real> {
-        self.velocity
-            + self
-                .angular_velocity
-                .cross(&(x - Point3::from(self.pose.translation.vector)))
+        self.velocity + self.angular_velocity.cross(&(x - self.reference()))
     }
 }
 

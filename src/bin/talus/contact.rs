@@ -1,48 +1,18 @@
-//! The `talus` command line.
+//! `talus contact`: the contact of two bodies from a small TOML file.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
-use clap::{Parser, Subcommand};
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 use serde::Deserialize;
+use talus::geometry::Shape;
+use talus::geometry::ShapeSpec;
 use talus::geometry::gjk::{GjkResult, gjk};
 use talus::geometry::overlap::overlap;
 use talus::geometry::sphere::{sphere_polyhedron, sphere_sphere};
-use talus::geometry::{Shape, ShapeSpec};
 
-#[derive(Parser)]
-#[command(
-    name = "talus",
-    version,
-    about = "Polyhedral discrete element method engine"
-)]
-struct Cli {
-    #[command(subcommand)]
-    command: Command,
-}
-
-#[derive(Subcommand)]
-enum Command {
-    /// Report the shapes of a two-body file and their contact (GJK, overlap volume,
-    /// contact point, normal, area), with the time each kernel takes.
-    Contact {
-        /// A TOML file with two [[body]] entries.
-        file: PathBuf,
-    },
-    /// Check a particle mesh (STL or OBJ) and print its mass properties.
-    Inspect {
-        /// The mesh file.
-        mesh: PathBuf,
-        /// Use the convex hull of a non-convex or open mesh.
-        #[arg(long)]
-        hull: bool,
-        /// Factor applied to the coordinates (1e-3 for a mesh in mm).
-        #[arg(long, default_value_t = 1.0)]
-        scale: f64,
-    },
-}
+use super::print_shape;
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -62,49 +32,7 @@ struct Body {
     rotation: [f64; 3],
 }
 
-fn main() -> Result<()> {
-    match Cli::parse().command {
-        Command::Contact { file } => contact(&file),
-        Command::Inspect { mesh, hull, scale } => {
-            let spec = ShapeSpec::Mesh {
-                file: mesh.clone(),
-                convex_hull: hull,
-                scale,
-            };
-            let shape = spec.build(Path::new(""))?;
-            print_shape(&mesh.display().to_string(), &shape);
-            Ok(())
-        }
-    }
-}
-
-fn print_shape(name: &str, shape: &Shape) {
-    println!("{name}:");
-    match shape {
-        Shape::Sphere(s) => println!("  sphere of radius {:.6e} m", s.radius),
-        Shape::Polyhedron(p) => {
-            println!(
-                "  convex polyhedron: {} vertices, {} edges, {} faces (coplanar triangles merged)",
-                p.vertices().len(),
-                p.edges().len(),
-                p.face_count()
-            );
-        }
-    }
-    let i = shape.principal_inertia();
-    println!("  volume                  {:.6e} m³", shape.volume());
-    println!(
-        "  principal inertia / ρ   [{:.6e}, {:.6e}, {:.6e}] m⁵",
-        i.x, i.y, i.z
-    );
-    println!("  circumscribed radius    {:.6e} m", shape.circumradius());
-    println!(
-        "  volume-equivalent radius {:.6e} m",
-        shape.equivalent_radius()
-    );
-}
-
-fn contact(file: &Path) -> Result<()> {
+pub fn contact(file: &Path) -> Result<()> {
     let text =
         std::fs::read_to_string(file).with_context(|| format!("cannot read {}", file.display()))?;
     let pair: PairFile =

@@ -1,0 +1,117 @@
+//! The `talus` command line.
+
+mod contact;
+mod run;
+
+use std::path::{Path, PathBuf};
+
+use anyhow::Result;
+use clap::{Parser, Subcommand};
+use talus::geometry::{Shape, ShapeSpec};
+
+#[derive(Parser)]
+#[command(
+    name = "talus",
+    version,
+    about = "Polyhedral discrete element method engine"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Validate a scene file and print what will be computed.
+    Check {
+        /// The scene (TOML).
+        scene: PathBuf,
+    },
+    /// Run a scene: progress, ParaView series, walls.csv, series.csv, summary.json.
+    Run {
+        /// The scene (TOML).
+        scene: PathBuf,
+        /// Output directory (default: the scene's [output] dir, or <scene>_out).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Worker threads (default: the scene's, else all cores).
+        #[arg(long, default_value_t = 0)]
+        threads: usize,
+        /// No progress bar.
+        #[arg(long)]
+        quiet: bool,
+    },
+    /// Report the shapes of a two-body file and their contact (GJK, overlap volume,
+    /// contact point, normal, area), with the time each kernel takes.
+    Contact {
+        /// A TOML file with two [[body]] entries.
+        file: PathBuf,
+    },
+    /// Check a particle mesh (STL or OBJ) and print its mass properties.
+    Inspect {
+        /// The mesh file.
+        mesh: PathBuf,
+        /// Use the convex hull of a non-convex or open mesh.
+        #[arg(long)]
+        hull: bool,
+        /// Factor applied to the coordinates (1e-3 for a mesh in mm).
+        #[arg(long, default_value_t = 1.0)]
+        scale: f64,
+    },
+}
+
+fn main() -> Result<()> {
+    match Cli::parse().command {
+        Command::Check { scene } => run::check(&scene),
+        Command::Run {
+            scene,
+            out,
+            threads,
+            quiet,
+        } => run::run(
+            &scene,
+            run::RunOptions {
+                out,
+                threads,
+                quiet,
+            },
+        ),
+        Command::Contact { file } => contact::contact(&file),
+        Command::Inspect { mesh, hull, scale } => {
+            let spec = ShapeSpec::Mesh {
+                file: mesh.clone(),
+                convex_hull: hull,
+                scale,
+            };
+            let shape = spec.build(Path::new(""))?;
+            print_shape(&mesh.display().to_string(), &shape);
+            Ok(())
+        }
+    }
+}
+
+fn print_shape(name: &str, shape: &Shape) {
+    println!("{name}:");
+    match shape {
+        Shape::Sphere(s) => println!("  sphere of radius {:.6e} m", s.radius),
+        Shape::Polyhedron(p) => {
+            println!(
+                "  convex polyhedron: {} vertices, {} edges, {} faces (coplanar triangles merged)",
+                p.vertices().len(),
+                p.edges().len(),
+                p.face_count()
+            );
+        }
+    }
+    let i = shape.principal_inertia();
+    println!("  volume                  {:.6e} m³", shape.volume());
+    println!(
+        "  principal inertia / ρ   [{:.6e}, {:.6e}, {:.6e}] m⁵",
+        i.x, i.y, i.z
+    );
+    println!("  circumscribed radius    {:.6e} m", shape.circumradius());
+    println!(
+        "  volume-equivalent radius {:.6e} m",
+        shape.equivalent_radius()
+    );
+}

@@ -1,0 +1,190 @@
+//! `talus check` and `talus run`: validate a scene, print its plan, and run it with
+//! progress, ParaView output, CSV series and a summary.
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
+
+use anyhow::{Context, Result};
+use indicatif::{ProgressBar, ProgressStyle};
+use talus::output::{RunOutput, Summary, WallSummary};
+use talus::scene::{Scene, Simulation};
+
+/// Loads a scene, printing its warnings.
+fn load(path: &Path) -> Result<Scene> {
+    let scene = Scene::load(path)?;
+    for w in &scene.warnings {
+        eprintln!("warning: {w}");
+    }
+    Ok(scene)
+}
+
+/// `talus check`: validates the scene and prints the plan.
+pub fn check(path: &Path) -> Result<()> {
+    let scene = load(path)?;
+    println!("{}: valid scene", path.display());
+    print!("{}", scene.plan);
+    Ok(())
+}
+
+/// Options of `talus run`.
+pub struct RunOptions {
+    /// Output directory (default: the scene's).
+    pub out: Option<PathBuf>,
+    /// Worker threads (0: the scene's setting, else all cores).
+    pub threads: usize,
+    /// No progress bar.
+    pub quiet: bool,
+}
+
+/// `talus run`.
+pub fn run(path: &Path, options: RunOptions) -> Result<()> {
+    let scene = load(path)?;
+    let threads = match (options.threads, scene.spec.simulation.threads) {
+        (0, 0) => std::thread::available_parallelism().map_or(1, |n| n.get()),
+        (0, t) | (t, _) => t,
+    };
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .context("cannot start the worker threads")?;
+    let dir = options.out.clone().unwrap_or_else(|| scene.output_dir());
+    let stop = Arc::new(AtomicBool::new(false));
+    {
+        let stop = stop.clone();
+        // A second Ctrl-C while the outputs are being written kills the process.
+        ctrlc::set_handler(move || {
+            if stop.swap(true, Ordering::SeqCst) {
+                std::process::exit(130);
+            }
+        })
+        .context("cannot install the Ctrl-C handler")?;
+    }
+    pool.install(|| run_loop(&scene, &dir, threads, &stop, options.quiet))
+}
+
+fn run_loop(
+    scene: &Scene,
+    dir: &Path,
+    threads: usize,
+    stop: &AtomicBool,
+    quiet: bool,
+) -> Result<()> {
+    let mut sim = Simulation::new(scene);
+    let mut out = RunOutput::create(
+        dir,
+        &sim.world,
+        scene.spec.output.frame_interval,
+        scene.spec.output.csv_interval,
+    )
+    .with_context(|| format!("cannot write to {}", dir.display()))?;
+    out.record(
+        &sim.world,
+        scene.dt,
+        sim.engine.contacts,
+        sim.max_speed(),
+        true,
+    )?;
+    let total_steps = (sim.end_time / scene.dt).ceil() as u64;
+    let bar = if quiet {
+        ProgressBar::hidden()
+    } else {
+        ProgressBar::new(total_steps)
+    };
+    bar.set_style(
+        ProgressStyle::with_template("{bar:30} {percent:>3}% t = {msg} | {per_sec} | ETA {eta}")
+            .expect("valid template"),
+    );
+    let started = Instant::now();
+    let mut contact_sum = 0u64;
+    let mut particle_steps = 0u64;
+    let mut last_draw = Instant::now();
+    let ended_by = loop {
+        if stop.load(Ordering::SeqCst) {
+            break "interrupted";
+        }
+        if sim.is_finished() {
+            break "end_time";
+        }
+        if sim.is_settled() {
+            break "settled";
+        }
+        // Land on the end time exactly.
+        let remaining = sim.end_time - sim.time();
+        let dt = scene.dt;
+        if remaining < dt {
+            sim.engine.dt = remaining;
+        }
+        particle_steps += sim.world.particles.len() as u64;
+        sim.step();
+        sim.engine.dt = dt;
+        contact_sum += sim.engine.contacts as u64;
+        out.record(&sim.world, dt, sim.engine.contacts, 0.0, false)?;
+        if last_draw.elapsed() > Duration::from_millis(200) {
+            last_draw = Instant::now();
+            bar.set_position(sim.steps);
+            bar.set_message(format!(
+                "{:.4e} s | {} particles | {} contacts",
+                sim.time(),
+                sim.world.particles.len(),
+                sim.engine.contacts
+            ));
+        }
+    };
+    bar.finish_and_clear();
+    out.record(
+        &sim.world,
+        scene.dt,
+        sim.engine.contacts,
+        sim.max_speed(),
+        true,
+    )?;
+    let elapsed = started.elapsed().as_secs_f64();
+    let report = sim.report();
+    let summary = Summary {
+        scene: scene.file.display().to_string(),
+        ended_by: ended_by.into(),
+        time: report.time,
+        dt: scene.dt,
+        suggested_dt: scene.suggested.as_ref().map(|s| s.dt),
+        steps: sim.steps,
+        wall_clock_s: elapsed,
+        particles: report.particles,
+        contacts: report.contacts,
+        particle_steps_per_s: particle_steps as f64 / elapsed.max(1e-9),
+        contacts_per_s: contact_sum as f64 / elapsed.max(1e-9),
+        kinetic_energy: report.kinetic_energy,
+        max_speed: report.max_speed,
+        frames: out.frames(),
+        walls: sim
+            .world
+            .walls
+            .iter()
+            .map(|w| WallSummary {
+                name: w.name.clone(),
+                force: w.force.into(),
+                torque: w.torque.into(),
+            })
+            .collect(),
+        threads,
+    };
+    out.write_summary(&summary)?;
+    println!(
+        "{}: {} at t = {:.6e} s after {} steps in {:.2} s ({:.3e} particle-steps/s, {:.3e} contacts/s); {} particles; output in {}",
+        scene.file.display(),
+        match ended_by {
+            "settled" => "settled",
+            "interrupted" => "interrupted",
+            _ => "finished",
+        },
+        report.time,
+        sim.steps,
+        elapsed,
+        summary.particle_steps_per_s,
+        summary.contacts_per_s,
+        report.particles,
+        dir.display()
+    );
+    Ok(())
+}

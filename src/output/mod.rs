@@ -1,0 +1,235 @@
+//! What a run leaves behind: a ParaView series, CSV time series and a summary.
+//!
+//! Layout of an output directory:
+//!
+//! - `particles.pvd`, `walls.pvd` and `frames/*.vtp`: the ParaView series (open the
+//!   `.pvd` files);
+//! - `walls.csv`: per wall, the force and torque (about the wall's reference point)
+//!   the particles exert on it, and the power the wall delivers to the particles, each
+//!   the mean over the interval since the previous row (impulse over time, so nothing
+//!   between rows is lost);
+//! - `series.csv`: particles, contacts, kinetic energy and largest speed;
+//! - `summary.json`: the run's figures.
+
+pub mod vtk;
+
+use std::fs::File;
+use std::io::{self, BufWriter, Write};
+use std::path::{Path, PathBuf};
+
+use nalgebra::Vector3;
+use serde::Serialize;
+
+use crate::Real;
+use crate::world::World;
+use vtk::Collection;
+
+/// Figures of a finished (or interrupted) run, written as `summary.json`.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct Summary {
+    /// The scene file.
+    pub scene: String,
+    /// How the run ended: "end_time", "settled" or "interrupted".
+    pub ended_by: String,
+    /// Simulated time reached, s.
+    pub time: Real,
+    /// Time step, s.
+    pub dt: Real,
+    /// Suggested time step, s.
+    pub suggested_dt: Option<Real>,
+    /// Steps taken.
+    pub steps: u64,
+    /// Wall-clock time, s.
+    pub wall_clock_s: Real,
+    /// Particles at the end.
+    pub particles: usize,
+    /// Contacts at the end.
+    pub contacts: usize,
+    /// Particle-steps per second of wall-clock time.
+    pub particle_steps_per_s: Real,
+    /// Contact evaluations per second of wall-clock time.
+    pub contacts_per_s: Real,
+    /// Kinetic energy at the end, J.
+    pub kinetic_energy: Real,
+    /// Largest particle speed at the end, m/s.
+    pub max_speed: Real,
+    /// ParaView frames written.
+    pub frames: usize,
+    /// Per wall: name, force and torque at the end.
+    pub walls: Vec<WallSummary>,
+    /// Threads used.
+    pub threads: usize,
+}
+
+/// A wall's state at the end of a run.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct WallSummary {
+    /// Name.
+    pub name: String,
+    /// Force the particles exert on it, N.
+    pub force: [Real; 3],
+    /// Torque about its reference point, N m.
+    pub torque: [Real; 3],
+}
+
+/// Writes a run's outputs as it goes.
+pub struct RunOutput {
+    dir: PathBuf,
+    particles: Collection,
+    walls: Collection,
+    walls_csv: BufWriter<File>,
+    series_csv: BufWriter<File>,
+    frame_interval: Option<Real>,
+    csv_interval: Option<Real>,
+    next_frame: Real,
+    next_row: Real,
+    last_row: Real,
+    /// Per wall: impulse, angular impulse, work delivered, since the last row.
+    impulses: Vec<[Vector3<Real>; 2]>,
+    work: Vec<Real>,
+}
+
+impl RunOutput {
+    /// Creates the directory (and `frames/` in it) and the CSV headers.
+    pub fn create(
+        dir: &Path,
+        world: &World,
+        frame_interval: Option<Real>,
+        csv_interval: Option<Real>,
+    ) -> io::Result<Self> {
+        std::fs::create_dir_all(dir.join("frames"))?;
+        let mut walls_csv = BufWriter::new(File::create(dir.join("walls.csv"))?);
+        let mut header = String::from("time");
+        for w in &world.walls {
+            for c in ["fx", "fy", "fz", "tx", "ty", "tz", "power"] {
+                header.push_str(&format!(",{}_{c}", w.name));
+            }
+        }
+        writeln!(walls_csv, "{header}")?;
+        let mut series_csv = BufWriter::new(File::create(dir.join("series.csv"))?);
+        writeln!(
+            series_csv,
+            "time,particles,contacts,kinetic_energy,max_speed"
+        )?;
+        Ok(RunOutput {
+            dir: dir.to_path_buf(),
+            particles: Collection::new(dir.join("particles.pvd")),
+            walls: Collection::new(dir.join("walls.pvd")),
+            walls_csv,
+            series_csv,
+            frame_interval,
+            csv_interval: csv_interval.or(frame_interval),
+            next_frame: world.time,
+            next_row: world.time,
+            last_row: world.time,
+            impulses: vec![[Vector3::zeros(); 2]; world.walls.len()],
+            work: vec![0.0; world.walls.len()],
+        })
+    }
+
+    /// The output directory.
+    pub fn dir(&self) -> &Path {
+        &self.dir
+    }
+
+    /// Frames written so far.
+    pub fn frames(&self) -> usize {
+        self.particles.len()
+    }
+
+    /// Called after every step of length `dt`: accumulates wall impulses and writes
+    /// the rows and frames that are due (all of them when `force` is set).
+    pub fn record(
+        &mut self,
+        world: &World,
+        dt: Real,
+        contacts: usize,
+        max_speed: Real,
+        force: bool,
+    ) -> io::Result<()> {
+        for (k, w) in world.walls.iter().enumerate() {
+            self.impulses[k][0] += w.force * dt;
+            self.impulses[k][1] += w.torque * dt;
+            self.work[k] -= (w.force.dot(&w.velocity) + w.torque.dot(&w.angular_velocity)) * dt;
+        }
+        let t = world.time;
+        let eps = 1e-9 * dt;
+        if force || self.csv_interval.is_some_and(|_| t >= self.next_row - eps) {
+            self.write_rows(world, contacts, max_speed)?;
+            if let Some(i) = self.csv_interval {
+                while self.next_row <= t + eps {
+                    self.next_row += i;
+                }
+            }
+        }
+        if force
+            || self
+                .frame_interval
+                .is_some_and(|_| t >= self.next_frame - eps)
+        {
+            self.write_frame(world)?;
+            if let Some(i) = self.frame_interval {
+                while self.next_frame <= t + eps {
+                    self.next_frame += i;
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn write_rows(&mut self, world: &World, contacts: usize, max_speed: Real) -> io::Result<()> {
+        let t = world.time;
+        let span = t - self.last_row;
+        let mut row = format!("{t:.9e}");
+        for (k, w) in world.walls.iter().enumerate() {
+            // The first row (no interval yet) holds the instantaneous values.
+            let (f, m, p) = if span > 0.0 {
+                (
+                    self.impulses[k][0] / span,
+                    self.impulses[k][1] / span,
+                    self.work[k] / span,
+                )
+            } else {
+                (
+                    w.force,
+                    w.torque,
+                    -(w.force.dot(&w.velocity) + w.torque.dot(&w.angular_velocity)),
+                )
+            };
+            for x in f.iter().chain(m.iter()).chain(std::iter::once(&p)) {
+                row.push_str(&format!(",{x:.9e}"));
+            }
+            self.impulses[k] = [Vector3::zeros(); 2];
+            self.work[k] = 0.0;
+        }
+        writeln!(self.walls_csv, "{row}")?;
+        writeln!(
+            self.series_csv,
+            "{t:.9e},{},{contacts},{:.9e},{max_speed:.9e}",
+            world.particles.len(),
+            world.kinetic_energy()
+        )?;
+        self.last_row = t;
+        self.walls_csv.flush()?;
+        self.series_csv.flush()
+    }
+
+    fn write_frame(&mut self, world: &World) -> io::Result<()> {
+        let k = self.particles.len();
+        let p = format!("frames/particles_{k:06}.vtp");
+        let w = format!("frames/walls_{k:06}.vtp");
+        vtk::write_particles(world, &self.dir.join(&p))?;
+        self.particles.add(world.time, p)?;
+        if !world.walls.is_empty() {
+            vtk::write_walls(world, &self.dir.join(&w))?;
+            self.walls.add(world.time, w)?;
+        }
+        Ok(())
+    }
+
+    /// Writes `summary.json`.
+    pub fn write_summary(&self, summary: &Summary) -> io::Result<()> {
+        let text = serde_json::to_string_pretty(summary).map_err(io::Error::other)?;
+        std::fs::write(self.dir.join("summary.json"), text + "\n")
+    }
+}

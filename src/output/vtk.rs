@@ -1,0 +1,267 @@
+//! ParaView output: VTK XML PolyData frames (`.vtp`, binary appended data) and the
+//! `.pvd` collections that make them a time series.
+//!
+//! Particles are written as their actual surfaces: every merged face of a polyhedron
+//! is one polygon cell in its current pose (spheres as 80-facet icospheres), with the
+//! particle's id, kind, velocity, speed and angular velocity on each of its cells.
+//! Walls are their facets in the current pose, with the wall index and the force on
+//! each facet.
+
+use std::fmt::Write as _;
+use std::fs::File;
+use std::io::{self, BufWriter, Write};
+use std::path::{Path, PathBuf};
+
+use nalgebra::Point3;
+
+use crate::Real;
+use crate::geometry::{Shape, generators};
+use crate::world::World;
+
+/// A data array of a `.vtp` file.
+enum Array {
+    F32 {
+        name: String,
+        components: usize,
+        data: Vec<f32>,
+    },
+    I64 {
+        name: String,
+        data: Vec<i64>,
+    },
+}
+
+impl Array {
+    fn header(&self, offset: usize) -> String {
+        match self {
+            Array::F32 {
+                name, components, ..
+            } => format!(
+                r#"<DataArray type="Float32" Name="{name}" NumberOfComponents="{components}" format="appended" offset="{offset}"/>"#
+            ),
+            Array::I64 { name, .. } => format!(
+                r#"<DataArray type="Int64" Name="{name}" format="appended" offset="{offset}"/>"#
+            ),
+        }
+    }
+
+    fn bytes(&self) -> Vec<u8> {
+        match self {
+            Array::F32 { data, .. } => data.iter().flat_map(|x| x.to_le_bytes()).collect(),
+            Array::I64 { data, .. } => data.iter().flat_map(|x| x.to_le_bytes()).collect(),
+        }
+    }
+}
+
+/// A polygon soup with per-cell fields, written as one `.vtp` piece.
+#[derive(Default)]
+struct PolyData {
+    points: Vec<f32>,
+    connectivity: Vec<i64>,
+    offsets: Vec<i64>,
+    cell_data: Vec<Array>,
+}
+
+impl PolyData {
+    fn add_polygon(&mut self, points: impl IntoIterator<Item = Point3<Real>>) {
+        for p in points {
+            self.connectivity.push((self.points.len() / 3) as i64);
+            self.points.extend(p.coords.iter().map(|&x| x as f32));
+        }
+        self.offsets.push(self.connectivity.len() as i64);
+    }
+
+    fn write(self, path: &Path) -> io::Result<()> {
+        let cells = self.offsets.len();
+        let points = Array::F32 {
+            name: "points".into(),
+            components: 3,
+            data: self.points,
+        };
+        let conn = Array::I64 {
+            name: "connectivity".into(),
+            data: self.connectivity,
+        };
+        let offs = Array::I64 {
+            name: "offsets".into(),
+            data: self.offsets,
+        };
+        let n_points = match &points {
+            Array::F32 { data, .. } => data.len() / 3,
+            Array::I64 { .. } => 0,
+        };
+        let mut blocks: Vec<Vec<u8>> = Vec::new();
+        let mut xml = String::new();
+        let mut offset = 0usize;
+        let mut header = |a: &Array, xml: &mut String, blocks: &mut Vec<Vec<u8>>| {
+            let b = a.bytes();
+            let _ = writeln!(xml, "        {}", a.header(offset));
+            offset += 8 + b.len();
+            blocks.push(b);
+        };
+        let _ = writeln!(
+            xml,
+            r#"<?xml version="1.0"?>
+<VTKFile type="PolyData" version="1.0" byte_order="LittleEndian" header_type="UInt64">
+  <PolyData>
+    <Piece NumberOfPoints="{n_points}" NumberOfVerts="0" NumberOfLines="0" NumberOfStrips="0" NumberOfPolys="{cells}">
+      <CellData>"#
+        );
+        for a in &self.cell_data {
+            header(a, &mut xml, &mut blocks);
+        }
+        xml.push_str("      </CellData>\n      <Points>\n");
+        header(&points, &mut xml, &mut blocks);
+        xml.push_str("      </Points>\n      <Polys>\n");
+        header(&conn, &mut xml, &mut blocks);
+        header(&offs, &mut xml, &mut blocks);
+        xml.push_str(
+            "      </Polys>\n    </Piece>\n  </PolyData>\n  <AppendedData encoding=\"raw\">\n   _",
+        );
+        let mut out = BufWriter::new(File::create(path)?);
+        out.write_all(xml.as_bytes())?;
+        for b in blocks {
+            out.write_all(&(b.len() as u64).to_le_bytes())?;
+            out.write_all(&b)?;
+        }
+        out.write_all(b"\n  </AppendedData>\n</VTKFile>\n")?;
+        out.flush()
+    }
+}
+
+/// Writes the particles of `world` as polygons to `path`.
+pub fn write_particles(world: &World, path: &Path) -> io::Result<()> {
+    let sphere = generators::icosphere_mesh(1, 1.0).expect("valid icosphere");
+    let mut pd = PolyData::default();
+    let (mut id, mut kind, mut vel, mut speed, mut omega) =
+        (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let p = &world.particles;
+    for i in 0..p.len() {
+        let t = &world.body_types[p.body_type[i] as usize];
+        let pose = nalgebra::Isometry3::from_parts(p.position[i].coords.into(), p.orientation[i]);
+        let faces = match &t.shape {
+            Shape::Polyhedron(poly) => {
+                for f in 0..poly.face_count() {
+                    pd.add_polygon(
+                        poly.face(f)
+                            .iter()
+                            .map(|&v| pose * poly.vertices()[v as usize]),
+                    );
+                }
+                poly.face_count()
+            }
+            Shape::Sphere(s) => {
+                for tri in &sphere.triangles {
+                    pd.add_polygon(
+                        tri.iter()
+                            .map(|&v| p.position[i] + sphere.vertices[v].coords * s.radius),
+                    );
+                }
+                sphere.triangles.len()
+            }
+        };
+        let w = world.angular_velocity(i);
+        for _ in 0..faces {
+            id.push(p.id[i] as i64);
+            kind.push(p.body_type[i] as i64);
+            vel.extend(p.velocity[i].iter().map(|&x| x as f32));
+            speed.push(p.velocity[i].norm() as f32);
+            omega.extend(w.iter().map(|&x| x as f32));
+        }
+    }
+    pd.cell_data = vec![
+        Array::I64 {
+            name: "id".into(),
+            data: id,
+        },
+        Array::I64 {
+            name: "kind".into(),
+            data: kind,
+        },
+        Array::F32 {
+            name: "velocity".into(),
+            components: 3,
+            data: vel,
+        },
+        Array::F32 {
+            name: "speed".into(),
+            components: 1,
+            data: speed,
+        },
+        Array::F32 {
+            name: "angular_velocity".into(),
+            components: 3,
+            data: omega,
+        },
+    ];
+    pd.write(path)
+}
+
+/// Writes every wall's facets in their current pose to `path`.
+pub fn write_walls(world: &World, path: &Path) -> io::Result<()> {
+    let mut pd = PolyData::default();
+    let (mut index, mut force) = (Vec::new(), Vec::new());
+    for (w, wall) in world.walls.iter().enumerate() {
+        for f in 0..wall.triangles.len() {
+            pd.add_polygon(wall.facet_world(f));
+            index.push(w as i64);
+            force.extend(wall.facet_force[f].iter().map(|&x| x as f32));
+        }
+    }
+    pd.cell_data = vec![
+        Array::I64 {
+            name: "wall".into(),
+            data: index,
+        },
+        Array::F32 {
+            name: "facet_force".into(),
+            components: 3,
+            data: force,
+        },
+    ];
+    pd.write(path)
+}
+
+/// A `.pvd` collection, rewritten whole after every frame so that it is valid even
+/// when a run is interrupted.
+#[derive(Clone, Debug)]
+pub struct Collection {
+    path: PathBuf,
+    frames: Vec<(Real, String)>,
+}
+
+impl Collection {
+    /// A collection written to `path`; frame file names are relative to its directory.
+    pub fn new(path: PathBuf) -> Self {
+        Collection {
+            path,
+            frames: Vec::new(),
+        }
+    }
+
+    /// Adds a frame at `time` and rewrites the collection.
+    pub fn add(&mut self, time: Real, file: String) -> io::Result<()> {
+        self.frames.push((time, file));
+        let mut s = String::from(
+            "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n  <Collection>\n",
+        );
+        for (t, f) in &self.frames {
+            let _ = writeln!(
+                s,
+                "    <DataSet timestep=\"{t:.9e}\" group=\"\" part=\"0\" file=\"{f}\"/>"
+            );
+        }
+        s.push_str("  </Collection>\n</VTKFile>\n");
+        std::fs::write(&self.path, s)
+    }
+
+    /// Number of frames.
+    pub fn len(&self) -> usize {
+        self.frames.len()
+    }
+
+    /// Whether there are none.
+    pub fn is_empty(&self) -> bool {
+        self.frames.is_empty()
+    }
+}

@@ -1,0 +1,578 @@
+//! From the scene as written to a validated [`Scene`]: materials, shapes, body types,
+//! walls, particles and inlets, each problem reported with its field.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use nalgebra::{Point3, UnitQuaternion, Vector3};
+use rand::SeedableRng;
+use rand_pcg::Pcg64;
+
+use super::error::{FieldError, FieldPath};
+use super::spec::*;
+use crate::Real;
+use crate::contact::Material;
+use crate::geometry::surfaces::{self, Surface};
+use crate::geometry::{Shape, mesh_io};
+use crate::world::{BodyType, Inlet, Wall, WallMotion, World, random_orientation};
+
+type Result<T> = std::result::Result<T, FieldError>;
+
+/// What the builder produces besides the world.
+pub(super) struct Built {
+    pub world: World,
+    pub inlets: Vec<Inlet>,
+    pub next_id: u64,
+}
+
+fn finite(path: FieldPath, values: &[Real]) -> Result<()> {
+    if values.iter().all(|v| v.is_finite()) {
+        Ok(())
+    } else {
+        Err(FieldError::new(path, "must be finite"))
+    }
+}
+
+fn positive(path: FieldPath, value: Real) -> Result<()> {
+    if value.is_finite() && value > 0.0 {
+        Ok(())
+    } else {
+        Err(FieldError::new(path, format!("{value} must be positive")))
+    }
+}
+
+fn lookup<'a, T>(
+    map: &'a BTreeMap<String, T>,
+    name: &str,
+    what: &str,
+    path: FieldPath,
+) -> Result<(usize, &'a T)> {
+    map.iter()
+        .enumerate()
+        .find(|(_, (k, _))| k.as_str() == name)
+        .map(|(i, (_, v))| (i, v))
+        .ok_or_else(|| {
+            let known: Vec<&str> = map.keys().map(String::as_str).collect();
+            FieldError::new(
+                path,
+                format!(
+                    "unknown {what} '{name}' (defined: {})",
+                    if known.is_empty() {
+                        "none".to_string()
+                    } else {
+                        known.join(", ")
+                    }
+                ),
+            )
+        })
+}
+
+pub(super) struct Builder<'a> {
+    spec: &'a SceneSpec,
+    dir: &'a Path,
+    shapes: Vec<Shape>,
+    body_types: BTreeMap<(usize, usize), u32>,
+    world: World,
+}
+
+impl<'a> Builder<'a> {
+    pub fn new(spec: &'a SceneSpec, dir: &'a Path) -> Self {
+        Builder {
+            spec,
+            dir,
+            shapes: Vec::new(),
+            body_types: BTreeMap::new(),
+            world: World::default(),
+        }
+    }
+
+    pub fn build(mut self) -> Result<Built> {
+        let sim = &self.spec.simulation;
+        finite(FieldPath::root("simulation").key("gravity"), &sim.gravity)?;
+        self.world.gravity = sim.gravity.into();
+        self.materials()?;
+        self.shapes()?;
+        let mut next_id = 0;
+        let mut rng = Pcg64::seed_from_u64(sim.seed);
+        for (g, group) in self.spec.particles.iter().enumerate() {
+            self.particle_group(g, group, &mut rng, &mut next_id)?;
+        }
+        let mut inlets = Vec::new();
+        for (k, inlet) in self.spec.inlets.iter().enumerate() {
+            inlets.push(self.inlet(k, inlet)?);
+        }
+        // Walls last: their facet grids are sized by the largest particle.
+        let cell = self.largest_diameter();
+        let mut names = std::collections::BTreeSet::new();
+        for (k, w) in self.spec.walls.iter().enumerate() {
+            let path = FieldPath::root("wall").index(k);
+            if !names.insert(w.name.as_str()) {
+                return Err(FieldError::new(
+                    path.key("name"),
+                    format!("wall name '{}' is used twice", w.name),
+                ));
+            }
+            let wall = self.wall(&path, w, cell)?;
+            self.world.walls.push(wall);
+        }
+        Ok(Built {
+            world: self.world,
+            inlets,
+            next_id,
+        })
+    }
+
+    fn largest_diameter(&self) -> Real {
+        let d = self
+            .world
+            .body_types
+            .iter()
+            .map(|t| 2.0 * t.shape.circumradius())
+            .fold(0.0, Real::max);
+        if d > 0.0 { d } else { 1.0 }
+    }
+
+    fn materials(&mut self) -> Result<()> {
+        if self.spec.materials.is_empty() {
+            return Err(FieldError::new(
+                FieldPath::root("materials"),
+                "at least one material is needed",
+            ));
+        }
+        for (name, m) in &self.spec.materials {
+            let material = Material {
+                name: name.clone(),
+                density: m.density,
+                young: m.young,
+                poisson: m.poisson,
+                restitution: m.restitution,
+                friction: m.friction,
+            };
+            material.validate().map_err(|e| {
+                let crate::contact::MaterialError::Invalid { field, .. } = &e;
+                FieldError::new(
+                    FieldPath::root("materials").key(name).key(field),
+                    e.to_string(),
+                )
+            })?;
+            self.world.materials.push(material);
+        }
+        Ok(())
+    }
+
+    fn shapes(&mut self) -> Result<()> {
+        for (name, spec) in &self.spec.shapes {
+            let shape = spec
+                .build(self.dir)
+                .map_err(|e| FieldError::new(FieldPath::root("shapes").key(name), e.to_string()))?;
+            self.shapes.push(shape);
+        }
+        Ok(())
+    }
+
+    /// The body type of (shape, material), created on first use.
+    fn body_type(&mut self, path: &FieldPath, shape: &str, material: &str) -> Result<u32> {
+        let (s, _) = lookup(&self.spec.shapes, shape, "shape", path.key("shape"))?;
+        let (m, _) = lookup(
+            &self.spec.materials,
+            material,
+            "material",
+            path.key("material"),
+        )?;
+        if let Some(&t) = self.body_types.get(&(s, m)) {
+            return Ok(t);
+        }
+        let t = self.world.body_types.len() as u32;
+        self.world.body_types.push(BodyType::new(
+            self.shapes[s].clone(),
+            &self.world.materials[m],
+            m,
+        ));
+        self.body_types.insert((s, m), t);
+        Ok(t)
+    }
+
+    /// Orientation of a particle whose shape is turned by `r` from how it was given.
+    fn orientation(&self, body_type: u32, r: UnitQuaternion<Real>) -> UnitQuaternion<Real> {
+        match &self.world.body_types[body_type as usize].shape {
+            Shape::Polyhedron(p) => r * p.body_to_input().rotation,
+            Shape::Sphere(_) => r,
+        }
+    }
+
+    fn particle_group(
+        &mut self,
+        g: usize,
+        group: &ParticleGroupSpec,
+        rng: &mut Pcg64,
+        next_id: &mut u64,
+    ) -> Result<()> {
+        let path = FieldPath::root("particles").index(g);
+        match group {
+            ParticleGroupSpec::Lattice {
+                shape,
+                material,
+                min,
+                max,
+                spacing,
+                count,
+                random_orientation: random,
+                velocity,
+            } => {
+                let t = self.body_type(&path, shape, material)?;
+                finite(path.key("min"), min)?;
+                finite(path.key("max"), max)?;
+                finite(path.key("velocity"), velocity)?;
+                let r = self.world.body_types[t as usize].shape.circumradius();
+                let a = spacing.unwrap_or(2.1 * r);
+                positive(path.key("spacing"), a)?;
+                let n: Vec<usize> = (0..3)
+                    .map(|k| {
+                        let span = max[k] - min[k] - 2.0 * r;
+                        if span < 0.0 {
+                            0
+                        } else {
+                            (span / a).floor() as usize + 1
+                        }
+                    })
+                    .collect();
+                if n.contains(&0) {
+                    return Err(FieldError::new(
+                        path.key("max"),
+                        format!(
+                            "the box is smaller than one particle (circumscribed diameter {})",
+                            2.0 * r
+                        ),
+                    ));
+                }
+                let limit = count.unwrap_or(usize::MAX);
+                let mut placed = 0;
+                'fill: for z in 0..n[2] {
+                    for y in 0..n[1] {
+                        for x in 0..n[0] {
+                            if placed >= limit {
+                                break 'fill;
+                            }
+                            let pos = Point3::new(
+                                min[0] + r + a * x as Real,
+                                min[1] + r + a * y as Real,
+                                min[2] + r + a * z as Real,
+                            );
+                            let q = if *random {
+                                random_orientation(rng)
+                            } else {
+                                self.orientation(t, UnitQuaternion::identity())
+                            };
+                            self.push(
+                                t,
+                                pos,
+                                q,
+                                Vector3::from(*velocity),
+                                Vector3::zeros(),
+                                next_id,
+                            );
+                            placed += 1;
+                        }
+                    }
+                }
+                if let Some(c) = count
+                    && placed < *c
+                {
+                    return Err(FieldError::new(
+                        path.key("count"),
+                        format!("only {placed} particles fit in the box at spacing {a}"),
+                    ));
+                }
+            }
+            ParticleGroupSpec::List {
+                shape,
+                material,
+                bodies,
+            } => {
+                let t = self.body_type(&path, shape, material)?;
+                for (b, body) in bodies.iter().enumerate() {
+                    let bp = path.key("bodies").index(b);
+                    for (field, v) in [
+                        ("position", &body.position),
+                        ("rotation", &body.rotation),
+                        ("velocity", &body.velocity),
+                        ("angular_velocity", &body.angular_velocity),
+                    ] {
+                        finite(bp.key(field), v)?;
+                    }
+                    let q = self.orientation(
+                        t,
+                        UnitQuaternion::from_scaled_axis(Vector3::from(body.rotation)),
+                    );
+                    self.push(
+                        t,
+                        body.position.into(),
+                        q,
+                        body.velocity.into(),
+                        body.angular_velocity.into(),
+                        next_id,
+                    );
+                }
+            }
+            ParticleGroupSpec::File {
+                shape,
+                material,
+                file,
+            } => {
+                let t = self.body_type(&path, shape, material)?;
+                let full = self.dir.join(file);
+                let poses = super::poses::read_poses(&full)
+                    .map_err(|e| FieldError::new(path.key("file"), e))?;
+                for pose in poses {
+                    self.push(
+                        t,
+                        pose.position,
+                        pose.orientation,
+                        pose.velocity,
+                        pose.angular_velocity,
+                        next_id,
+                    );
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn push(
+        &mut self,
+        t: u32,
+        x: Point3<Real>,
+        q: UnitQuaternion<Real>,
+        v: Vector3<Real>,
+        w: Vector3<Real>,
+        next_id: &mut u64,
+    ) {
+        let p = &mut self.world.particles;
+        p.push(t, x, q, *next_id);
+        *next_id += 1;
+        let last = p.len() - 1;
+        p.velocity[last] = v;
+        // Angular momentum L = R I Rᵀ ω.
+        let inertia = self.world.body_types[t as usize].inertia;
+        p.angular_momentum[last] = q * q.inverse_transform_vector(&w).component_mul(&inertia);
+    }
+
+    fn inlet(&mut self, k: usize, spec: &InletSpec) -> Result<Inlet> {
+        let path = FieldPath::root("inlet").index(k);
+        let t = self.body_type(&path, &spec.shape, &spec.material)?;
+        finite(path.key("min"), &spec.min)?;
+        finite(path.key("max"), &spec.max)?;
+        finite(path.key("velocity"), &spec.velocity)?;
+        positive(path.key("rate"), spec.rate)?;
+        let r = self.world.body_types[t as usize].shape.circumradius();
+        for i in 0..3 {
+            if spec.max[i] - spec.min[i] < 2.0 * r {
+                return Err(FieldError::new(
+                    path.key("max"),
+                    format!(
+                        "the insertion box is narrower than one particle (circumscribed diameter {})",
+                        2.0 * r
+                    ),
+                ));
+            }
+        }
+        Ok(Inlet::new(
+            t,
+            spec.min.into(),
+            spec.max.into(),
+            spec.rate,
+            spec.count,
+            spec.velocity.into(),
+            spec.start,
+            self.spec.simulation.seed.wrapping_add(1 + k as u64),
+        ))
+    }
+
+    fn wall(&self, path: &FieldPath, w: &WallSpec, cell: Real) -> Result<Wall> {
+        let (material, _) = lookup(
+            &self.spec.materials,
+            &w.material,
+            "material",
+            path.key("material"),
+        )?;
+        let gpath = path.key("geometry");
+        let surface = self.surface(&gpath, &w.geometry)?;
+        if surface.triangles.is_empty() {
+            return Err(FieldError::new(gpath, "the wall has no facets"));
+        }
+        let (motion, pivot) = motion(&path.key("motion"), &w.motion)?;
+        let reference = match (w.reference, pivot) {
+            (Some(r), Some(p)) if (Vector3::from(r) - p.coords).norm() > 0.0 => {
+                return Err(FieldError::new(
+                    path.key("reference"),
+                    "a rotating wall turns about its reference point: give the rotation's point only",
+                ));
+            }
+            (Some(r), _) => Point3::from(r),
+            (None, Some(p)) => p,
+            (None, None) => Point3::origin(),
+        };
+        Ok(
+            Wall::new(&w.name, material, surface.vertices, surface.triangles, cell)
+                .with_reference(reference)
+                .with_motion(motion),
+        )
+    }
+
+    fn surface(&self, path: &FieldPath, g: &WallGeometrySpec) -> Result<Surface> {
+        let err = |e: crate::geometry::GeometryError| FieldError::new(path.clone(), e.to_string());
+        let v = |a: &[Real; 3]| Vector3::from(*a);
+        let p = |a: &[Real; 3]| Point3::from(*a);
+        match g {
+            WallGeometrySpec::Mesh { file, scale, flip } => {
+                positive(path.key("scale"), *scale)?;
+                let mesh = mesh_io::read_mesh(&self.dir.join(file))
+                    .map_err(|e| FieldError::new(path.key("file"), e.to_string()))?;
+                let s = Surface {
+                    vertices: mesh.vertices.iter().map(|x| x * *scale).collect(),
+                    triangles: mesh.triangles.iter().map(|t| t.map(|i| i as u32)).collect(),
+                };
+                Ok(if *flip { s.flipped() } else { s })
+            }
+            WallGeometrySpec::Plane {
+                centre,
+                normal,
+                size,
+            } => surfaces::plane(p(centre), v(normal), *size).map_err(err),
+            WallGeometrySpec::Box { min, max, open_top } => {
+                surfaces::box_inside(p(min), p(max), *open_top).map_err(err)
+            }
+            WallGeometrySpec::Disc {
+                centre,
+                normal,
+                radius,
+                inner_radius,
+                sides,
+            } => surfaces::disc(p(centre), v(normal), *radius, *inner_radius, *sides).map_err(err),
+            WallGeometrySpec::Cylinder {
+                base,
+                axis,
+                length,
+                radius,
+                sides,
+                segments,
+                bottom,
+                top,
+            } => surfaces::cylinder_inside(
+                p(base),
+                v(axis),
+                *length,
+                *radius,
+                *sides,
+                *segments,
+                *bottom,
+                *top,
+            )
+            .map_err(err),
+            WallGeometrySpec::Cone {
+                base,
+                axis,
+                length,
+                radius_bottom,
+                radius_top,
+                sides,
+                segments,
+            } => surfaces::frustum_inside(
+                p(base),
+                v(axis),
+                *length,
+                *radius_bottom,
+                *radius_top,
+                *sides,
+                *segments,
+            )
+            .map_err(err),
+        }
+    }
+}
+
+/// The wall motion of a spec, and the point a rotation turns about.
+fn motion(path: &FieldPath, m: &MotionSpec) -> Result<(WallMotion, Option<Point3<Real>>)> {
+    Ok(match m {
+        MotionSpec::Fixed => (WallMotion::Fixed, None),
+        MotionSpec::Linear { velocity } => {
+            finite(path.key("velocity"), velocity)?;
+            (
+                WallMotion::Constant {
+                    velocity: (*velocity).into(),
+                    angular_velocity: Vector3::zeros(),
+                },
+                None,
+            )
+        }
+        MotionSpec::Rotation {
+            axis,
+            point,
+            rpm,
+            rate,
+        } => {
+            finite(path.key("point"), point)?;
+            let axis = Vector3::from(*axis);
+            if !(axis.norm() > 0.0 && axis.norm().is_finite()) {
+                return Err(FieldError::new(
+                    path.key("axis"),
+                    "must be a non-zero vector",
+                ));
+            }
+            let rate = match (rpm, rate) {
+                (Some(rpm), None) => rpm * std::f64::consts::TAU / 60.0,
+                (None, Some(r)) => *r,
+                _ => {
+                    return Err(FieldError::new(
+                        path.clone(),
+                        "give exactly one of `rpm` and `rate`",
+                    ));
+                }
+            };
+            finite(
+                path.key(if rpm.is_some() { "rpm" } else { "rate" }),
+                &[rate],
+            )?;
+            (
+                WallMotion::Constant {
+                    velocity: Vector3::zeros(),
+                    angular_velocity: axis.normalize() * rate,
+                },
+                Some(Point3::from(*point)),
+            )
+        }
+        MotionSpec::Oscillation {
+            amplitude,
+            frequency,
+        } => {
+            finite(path.key("amplitude"), amplitude)?;
+            positive(path.key("frequency"), *frequency)?;
+            (
+                WallMotion::Oscillation {
+                    amplitude: (*amplitude).into(),
+                    frequency: *frequency,
+                },
+                None,
+            )
+        }
+        MotionSpec::Table { keys } => {
+            if keys.is_empty() {
+                return Err(FieldError::new(path.key("keys"), "needs at least one key"));
+            }
+            for (k, key) in keys.iter().enumerate() {
+                let kp = path.key("keys").index(k);
+                finite(kp.key("time"), &[key.time])?;
+                finite(kp.key("velocity"), &key.velocity)?;
+                finite(kp.key("angular_velocity"), &key.angular_velocity)?;
+                if k > 0 && key.time < keys[k - 1].time {
+                    return Err(FieldError::new(
+                        kp.key("time"),
+                        "keys must be in increasing time",
+                    ));
+                }
+            }
+            (WallMotion::Table(keys.clone()), None)
+        }
+        MotionSpec::External => (WallMotion::External, None),
+    })
+}

@@ -1,0 +1,190 @@
+//! The pipeline a scene needs, in words: which kernels run, what state is kept, and
+//! why. Printed by `talus check`.
+
+use std::fmt;
+
+use super::spec::SceneSpec;
+use crate::Real;
+use crate::engine::time_step::TimeStepEstimate;
+use crate::geometry::Shape;
+use crate::world::{Inlet, WallMotion, World};
+
+/// What a scene will compute.
+#[derive(Clone, Debug, Default)]
+pub struct Plan {
+    /// Lines of the plan, each "what: why".
+    pub lines: Vec<(String, String)>,
+    /// Whether any contact carries friction (tangential history kept).
+    pub friction: bool,
+    /// Whether polyhedron–polyhedron contacts can occur.
+    pub polyhedra: bool,
+    /// Whether any wall moves.
+    pub moving_walls: bool,
+}
+
+impl Plan {
+    /// The plan of a built scene.
+    pub fn new(
+        world: &World,
+        inlets: &[Inlet],
+        dt: Real,
+        suggested: &Option<TimeStepEstimate>,
+        spec: &SceneSpec,
+    ) -> Plan {
+        let mut plan = Plan::default();
+        let mut line = |what: String, why: String| plan.lines.push((what, why));
+        let types = &world.body_types;
+        let n_poly = types
+            .iter()
+            .filter(|t| t.shape.as_polyhedron().is_some())
+            .count();
+        let n_sphere = types.len() - n_poly;
+        let inserted: usize = inlets.iter().map(|i| i.count).sum();
+        line(
+            format!(
+                "particles: {} at start, {} from {} inlet(s)",
+                world.particles.len(),
+                inserted,
+                inlets.len()
+            ),
+            format!("{} particle kind(s)", types.len()),
+        );
+        for (k, t) in types.iter().enumerate() {
+            let shape = match &t.shape {
+                Shape::Sphere(s) => format!("sphere r = {:.4e} m", s.radius),
+                Shape::Polyhedron(p) => format!(
+                    "polyhedron, {} vertices, {} faces, circumradius {:.4e} m",
+                    p.vertices().len(),
+                    p.face_count(),
+                    p.circumradius()
+                ),
+            };
+            line(
+                format!("  kind {k}: {shape}"),
+                format!(
+                    "material '{}', mass {:.4e} kg",
+                    world.materials[t.material].name, t.mass
+                ),
+            );
+        }
+        if n_poly > 0 {
+            line(
+                "polyhedron–polyhedron: GJK, then exact overlap volume".into(),
+                "polyhedral kinds present".into(),
+            );
+        }
+        if n_sphere > 0 {
+            line(
+                "sphere–sphere: analytic lens".into(),
+                "sphere kinds present (no GJK, no clipping)".into(),
+            );
+        }
+        if n_poly > 0 && n_sphere > 0 {
+            line(
+                "sphere–polyhedron: closest feature and cap".into(),
+                "mixed kinds".into(),
+            );
+        }
+        let used: Vec<usize> = types
+            .iter()
+            .map(|t| t.material)
+            .chain(world.walls.iter().map(|w| w.material))
+            .collect();
+        let friction = used.iter().any(|&m| world.materials[m].friction > 0.0);
+        line(
+            format!(
+                "tangential history: {}",
+                if friction { "kept per contact" } else { "none" }
+            ),
+            if friction {
+                "a material has friction".into()
+            } else {
+                "every friction coefficient is 0".into()
+            },
+        );
+        let r: Vec<Real> = types.iter().map(|t| t.shape.circumradius()).collect();
+        let ratio = r.iter().copied().fold(0.0, Real::max)
+            / r.iter().copied().fold(Real::INFINITY, Real::min);
+        line(
+            format!(
+                "broad phase: {} cell grid level(s)",
+                if ratio.is_finite() {
+                    ratio.log2().floor() as usize + 1
+                } else {
+                    1
+                }
+            ),
+            format!(
+                "size ratio {:.3}",
+                if ratio.is_finite() { ratio } else { 1.0 }
+            ),
+        );
+        let moving = world.walls.iter().filter(|w| !w.motion.is_fixed()).count();
+        for w in &world.walls {
+            let motion = match &w.motion {
+                WallMotion::Fixed => "fixed".to_string(),
+                WallMotion::Constant {
+                    velocity,
+                    angular_velocity,
+                } => format!(
+                    "velocity {:?} m/s, angular velocity {:?} rad/s",
+                    velocity.as_slice(),
+                    angular_velocity.as_slice()
+                ),
+                WallMotion::Oscillation {
+                    amplitude,
+                    frequency,
+                } => {
+                    format!("oscillation {:?} m at {frequency} Hz", amplitude.as_slice())
+                }
+                WallMotion::Table(k) => format!("time table of {} keys", k.len()),
+                WallMotion::External => "driven from outside".into(),
+            };
+            line(
+                format!("wall '{}': {} facets", w.name, w.triangles.len()),
+                format!(
+                    "{motion}; material '{}'; reference point {:?}",
+                    world.materials[w.material].name,
+                    w.reference().coords.as_slice()
+                ),
+            );
+        }
+        line(
+            format!(
+                "wall kinematics: {}",
+                if moving > 0 {
+                    "advanced every step"
+                } else {
+                    "none"
+                }
+            ),
+            format!("{moving} of {} wall(s) move", world.walls.len()),
+        );
+        line(
+            format!(
+                "time step: {dt:.4e} s, end time {} s",
+                spec.simulation.end_time
+            ),
+            match suggested {
+                Some(s) => format!(
+                    "suggested {:.4e} s ({}, contact period {:.3e} s)",
+                    s.dt, s.limited_by, s.period
+                ),
+                None => "no particle kinds".into(),
+            },
+        );
+        plan.friction = friction;
+        plan.polyhedra = n_poly > 0;
+        plan.moving_walls = moving > 0;
+        plan
+    }
+}
+
+impl fmt::Display for Plan {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        for (what, why) in &self.lines {
+            writeln!(f, "{what:<60} ({why})")?;
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,144 @@
+//! A running scene: world, engine and inlets advanced step by step, with the
+//! settling criterion.
+
+use nalgebra::Vector3;
+
+use super::Scene;
+use super::spec::SettleSpec;
+use crate::Real;
+use crate::engine::step::Engine;
+use crate::world::{Inlet, World};
+
+/// A scene being simulated.
+#[derive(Debug)]
+pub struct Simulation {
+    /// The state.
+    pub world: World,
+    /// The CPU engine (time step, contact history).
+    pub engine: Engine,
+    /// Particle sources.
+    pub inlets: Vec<Inlet>,
+    /// Steps taken.
+    pub steps: u64,
+    /// End time of the run.
+    pub end_time: Real,
+    next_id: u64,
+    settle: Option<SettleSpec>,
+    quiet_since: Option<Real>,
+}
+
+/// Figures of the state after a step.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct StepReport {
+    /// Simulated time.
+    pub time: Real,
+    /// Particles in the world.
+    pub particles: usize,
+    /// Contacts in the last force evaluation.
+    pub contacts: usize,
+    /// Largest particle speed.
+    pub max_speed: Real,
+    /// Total kinetic energy.
+    pub kinetic_energy: Real,
+}
+
+impl Simulation {
+    /// Starts a scene at time 0 (inlets insert what is due at 0).
+    pub fn new(scene: &Scene) -> Self {
+        let mut engine = Engine::new(scene.dt);
+        engine.regularisation_length = scene.spec.contact.regularisation;
+        let mut sim = Simulation {
+            world: scene.world.clone(),
+            engine,
+            inlets: scene.inlets.clone(),
+            steps: 0,
+            end_time: scene.spec.simulation.end_time,
+            next_id: scene.next_id,
+            settle: scene.spec.simulation.settle.clone(),
+            quiet_since: None,
+        };
+        sim.insert();
+        sim.engine.initialise(&mut sim.world);
+        sim
+    }
+
+    /// Simulated time.
+    pub fn time(&self) -> Real {
+        self.world.time
+    }
+
+    /// Whether the end time is reached.
+    pub fn is_finished(&self) -> bool {
+        self.world.time >= self.end_time - 1e-9 * self.engine.dt
+    }
+
+    /// Advances one time step, then lets inlets insert what is due.
+    pub fn step(&mut self) {
+        self.engine.step(&mut self.world);
+        self.steps += 1;
+        self.insert();
+        self.update_settling();
+    }
+
+    fn insert(&mut self) {
+        let first = self.world.particles.len();
+        let t = self.world.time;
+        for inlet in &mut self.inlets {
+            inlet.insert_due(&mut self.world, t, &mut self.next_id);
+        }
+        // New particles feel gravity in their first half kick.
+        let p = &mut self.world.particles;
+        for i in first..p.len() {
+            p.force[i] = self.world.gravity * self.world.body_types[p.body_type[i] as usize].mass;
+            p.torque[i] = Vector3::zeros();
+        }
+    }
+
+    /// Figures of the current state.
+    pub fn report(&self) -> StepReport {
+        StepReport {
+            time: self.world.time,
+            particles: self.world.particles.len(),
+            contacts: self.engine.contacts,
+            max_speed: self.max_speed(),
+            kinetic_energy: self.world.kinetic_energy(),
+        }
+    }
+
+    /// Largest particle speed (translation).
+    pub fn max_speed(&self) -> Real {
+        self.world
+            .particles
+            .velocity
+            .iter()
+            .map(|v| v.norm())
+            .fold(0.0, Real::max)
+    }
+
+    /// Whether every inlet has inserted all its particles.
+    pub fn inlets_done(&self) -> bool {
+        self.inlets.iter().all(Inlet::is_done)
+    }
+
+    /// Whether the scene's settling criterion has held long enough.
+    pub fn is_settled(&self) -> bool {
+        match (&self.settle, self.quiet_since) {
+            (Some(s), Some(since)) => self.world.time - since >= s.hold,
+            _ => false,
+        }
+    }
+
+    fn update_settling(&mut self) {
+        let Some(s) = &self.settle else { return };
+        let n = self.world.particles.len().max(1) as Real;
+        let quiet = self.world.time >= s.after
+            && self.inlets_done()
+            && self.max_speed() < s.max_speed
+            && self.world.kinetic_energy() / n < s.kinetic_energy_per_particle;
+        self.quiet_since = match (quiet, self.quiet_since) {
+            (true, None) => Some(self.world.time),
+            (true, since) => since,
+            (false, _) => None,
+        };
+    }
+}

@@ -1,0 +1,429 @@
+//! The scene file as written: serde structures of the TOML document.
+//!
+//! Every table rejects unknown fields, so that a misspelt key is an error with its
+//! line rather than a silently ignored setting. Lengths are in metres, times in
+//! seconds, angles in radians unless a field says otherwise.
+
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+
+use serde::{Deserialize, Serialize};
+
+use crate::Real;
+use crate::geometry::ShapeSpec;
+use crate::world::MotionKey;
+
+/// The whole scene file.
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneSpec {
+    /// Time stepping, gravity, end.
+    pub simulation: SimulationSpec,
+    /// Contact-law settings.
+    #[serde(default)]
+    pub contact: ContactSpec,
+    /// What is written, and how often.
+    #[serde(default)]
+    pub output: OutputSpec,
+    /// Materials by name.
+    pub materials: BTreeMap<String, MaterialSpec>,
+    /// Particle shapes by name.
+    #[serde(default)]
+    pub shapes: BTreeMap<String, ShapeSpec>,
+    /// Walls, in output order.
+    #[serde(default, rename = "wall")]
+    pub walls: Vec<WallSpec>,
+    /// Particles present at the start.
+    #[serde(default)]
+    pub particles: Vec<ParticleGroupSpec>,
+    /// Particle sources.
+    #[serde(default, rename = "inlet")]
+    pub inlets: Vec<InletSpec>,
+}
+
+/// `[simulation]`.
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct SimulationSpec {
+    /// Time step: a number of seconds, or `"auto"` for the suggested one.
+    #[serde(default)]
+    pub dt: TimeStepSpec,
+    /// Simulated time at which the run ends.
+    pub end_time: Real,
+    /// Gravitational acceleration.
+    #[serde(default = "default_gravity")]
+    pub gravity: [Real; 3],
+    /// Seed of the random generator (inlets, random orientations).
+    #[serde(default)]
+    pub seed: u64,
+    /// Worker threads (0: all cores).
+    #[serde(default)]
+    pub threads: usize,
+    /// End the run early once the bed has settled.
+    #[serde(default)]
+    pub settle: Option<SettleSpec>,
+}
+
+fn default_gravity() -> [Real; 3] {
+    [0.0, 0.0, -9.81]
+}
+
+/// The time step: fixed or suggested.
+#[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize)]
+#[serde(untagged)]
+pub enum TimeStepSpec {
+    /// Seconds.
+    Fixed(Real),
+    /// `"auto"`: the suggested step.
+    #[default]
+    #[serde(with = "auto")]
+    Auto,
+}
+
+mod auto {
+    use serde::{Deserialize, Deserializer, Serializer, de::Error};
+
+    pub fn serialize<S: Serializer>(s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str("auto")
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<(), D::Error> {
+        let s = String::deserialize(d)?;
+        if s == "auto" {
+            Ok(())
+        } else {
+            Err(D::Error::custom(
+                "dt must be a number of seconds or \"auto\"",
+            ))
+        }
+    }
+}
+
+/// When a run counts as settled: every particle slower than `max_speed` and the mean
+/// kinetic energy per particle below `kinetic_energy_per_particle`, for `hold` seconds,
+/// and no inlet still inserting.
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct SettleSpec {
+    /// Largest particle speed, m/s.
+    pub max_speed: Real,
+    /// Mean kinetic energy per particle, J.
+    #[serde(default = "infinite")]
+    pub kinetic_energy_per_particle: Real,
+    /// How long both must hold, s.
+    #[serde(default)]
+    pub hold: Real,
+    /// Do not stop before this time, s.
+    #[serde(default)]
+    pub after: Real,
+}
+
+fn infinite() -> Real {
+    Real::INFINITY
+}
+
+/// `[contact]`.
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct ContactSpec {
+    /// Regularisation length of the volume law, relative to the smaller equivalent
+    /// radius (see `contact::normal_force`).
+    #[serde(default = "default_regularisation")]
+    pub regularisation: Real,
+}
+
+impl Default for ContactSpec {
+    fn default() -> Self {
+        ContactSpec {
+            regularisation: default_regularisation(),
+        }
+    }
+}
+
+fn default_regularisation() -> Real {
+    crate::engine::step::REGULARISATION_LENGTH
+}
+
+/// `[output]`.
+#[derive(Clone, Debug, Default, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct OutputSpec {
+    /// Output directory, relative to the scene file (the command line may override).
+    pub dir: Option<PathBuf>,
+    /// Interval between ParaView frames, s (none: first and last frame only).
+    pub frame_interval: Option<Real>,
+    /// Interval between rows of `walls.csv` and `energy.csv`, s (none: every frame).
+    pub csv_interval: Option<Real>,
+}
+
+/// A material (SI units).
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct MaterialSpec {
+    /// Density, kg/m³.
+    pub density: Real,
+    /// Young's modulus, Pa.
+    pub young: Real,
+    /// Poisson's ratio.
+    pub poisson: Real,
+    /// Coefficient of restitution.
+    pub restitution: Real,
+    /// Coulomb friction coefficient.
+    #[serde(default)]
+    pub friction: Real,
+}
+
+/// `[[wall]]`.
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct WallSpec {
+    /// Name (unique), used in outputs and co-simulation variables.
+    pub name: String,
+    /// Material name.
+    pub material: String,
+    /// The surface.
+    pub geometry: WallGeometrySpec,
+    /// Reference point: frame origin, about which torque is reported (default: the
+    /// rotation point of a rotating wall, else the world origin).
+    pub reference: Option<[Real; 3]>,
+    /// How the wall moves.
+    #[serde(default)]
+    pub motion: MotionSpec,
+}
+
+/// The surface of a wall.
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum WallGeometrySpec {
+    /// A triangle mesh file (STL or OBJ); facets face the particles.
+    Mesh {
+        /// Path relative to the scene file.
+        file: PathBuf,
+        /// Factor applied to the coordinates.
+        #[serde(default = "one")]
+        scale: Real,
+        /// Turn every facet over (for a mesh whose normals point away from the
+        /// particles).
+        #[serde(default)]
+        flip: bool,
+    },
+    /// A square patch.
+    Plane {
+        /// Centre.
+        centre: [Real; 3],
+        /// Normal, towards the particles.
+        normal: [Real; 3],
+        /// Edge length.
+        size: Real,
+    },
+    /// The inside of an axis-aligned box.
+    Box {
+        /// Lower corner.
+        min: [Real; 3],
+        /// Upper corner.
+        max: [Real; 3],
+        /// Leave out the face at `max.z`.
+        #[serde(default)]
+        open_top: bool,
+    },
+    /// A flat disc or annulus.
+    Disc {
+        /// Centre.
+        centre: [Real; 3],
+        /// Normal, towards the particles.
+        normal: [Real; 3],
+        /// Outer radius.
+        radius: Real,
+        /// Radius of a central hole.
+        #[serde(default)]
+        inner_radius: Real,
+        /// Polygon sides.
+        #[serde(default = "default_sides")]
+        sides: usize,
+    },
+    /// The inside of a cylinder (a tube, or a drum with both caps).
+    Cylinder {
+        /// Centre of the bottom end.
+        base: [Real; 3],
+        /// Axis direction (from the bottom end to the top end).
+        axis: [Real; 3],
+        /// Length along the axis.
+        length: Real,
+        /// Radius.
+        radius: Real,
+        /// Polygon sides.
+        #[serde(default = "default_sides")]
+        sides: usize,
+        /// Rings of facets along the axis.
+        #[serde(default = "one_usize")]
+        segments: usize,
+        /// Close the bottom end.
+        #[serde(default)]
+        bottom: bool,
+        /// Close the top end.
+        #[serde(default)]
+        top: bool,
+    },
+    /// The inside of a cone frustum (a hopper).
+    Cone {
+        /// Centre of the bottom end.
+        base: [Real; 3],
+        /// Axis direction.
+        axis: [Real; 3],
+        /// Length along the axis.
+        length: Real,
+        /// Radius at the bottom end.
+        radius_bottom: Real,
+        /// Radius at the top end.
+        radius_top: Real,
+        /// Polygon sides.
+        #[serde(default = "default_sides")]
+        sides: usize,
+        /// Rings of facets along the axis.
+        #[serde(default = "one_usize")]
+        segments: usize,
+    },
+}
+
+fn one() -> Real {
+    1.0
+}
+
+fn one_usize() -> usize {
+    1
+}
+
+fn default_sides() -> usize {
+    48
+}
+
+/// How a wall moves.
+#[derive(Clone, Debug, Default, Deserialize, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum MotionSpec {
+    /// At rest.
+    #[default]
+    Fixed,
+    /// Constant linear velocity.
+    Linear {
+        /// Velocity, m/s.
+        velocity: [Real; 3],
+    },
+    /// Rotation about an axis through a point at a constant rate.
+    Rotation {
+        /// Axis direction (right-hand rule).
+        axis: [Real; 3],
+        /// Point on the axis (becomes the wall's reference point).
+        #[serde(default)]
+        point: [Real; 3],
+        /// Revolutions per minute (or give `rate`).
+        rpm: Option<Real>,
+        /// Rad/s (or give `rpm`).
+        rate: Option<Real>,
+    },
+    /// Harmonic translation `amplitude · sin(2π f t)`.
+    Oscillation {
+        /// Displacement amplitude vector, m.
+        amplitude: [Real; 3],
+        /// Frequency, Hz.
+        frequency: Real,
+    },
+    /// Velocities interpolated linearly in time between keys.
+    Table {
+        /// The keys, in increasing time.
+        keys: Vec<MotionKey>,
+    },
+    /// Driven from outside (co-simulation inputs), at rest until set.
+    External,
+}
+
+/// `[[particles]]`: particles present at the start.
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum ParticleGroupSpec {
+    /// A simple cubic lattice filling a box.
+    Lattice {
+        /// Shape name.
+        shape: String,
+        /// Material name.
+        material: String,
+        /// Lower corner of the region the particles' bounding spheres stay in.
+        min: [Real; 3],
+        /// Upper corner.
+        max: [Real; 3],
+        /// Lattice spacing (default: 1.05 circumscribed diameters).
+        spacing: Option<Real>,
+        /// At most this many particles.
+        count: Option<usize>,
+        /// Random orientations (default) or the shape as given.
+        #[serde(default = "yes")]
+        random_orientation: bool,
+        /// Initial velocity.
+        #[serde(default)]
+        velocity: [Real; 3],
+    },
+    /// Particles listed one by one.
+    List {
+        /// Shape name.
+        shape: String,
+        /// Material name.
+        material: String,
+        /// The bodies.
+        bodies: Vec<BodySpec>,
+    },
+    /// Poses from a CSV file with the header
+    /// `x,y,z,qw,qx,qy,qz` (and optionally `vx,vy,vz,wx,wy,wz`).
+    File {
+        /// Shape name.
+        shape: String,
+        /// Material name.
+        material: String,
+        /// Path relative to the scene file.
+        file: PathBuf,
+    },
+}
+
+fn yes() -> bool {
+    true
+}
+
+/// One listed particle.
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct BodySpec {
+    /// Centroid.
+    pub position: [Real; 3],
+    /// Rotation vector (axis times angle, rad) applied to the shape as given.
+    #[serde(default)]
+    pub rotation: [Real; 3],
+    /// Velocity.
+    #[serde(default)]
+    pub velocity: [Real; 3],
+    /// Angular velocity.
+    #[serde(default)]
+    pub angular_velocity: [Real; 3],
+}
+
+/// `[[inlet]]`: inserts particles into a box at a rate.
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct InletSpec {
+    /// Shape name.
+    pub shape: String,
+    /// Material name.
+    pub material: String,
+    /// Lower corner of the insertion box (bounding spheres stay inside).
+    pub min: [Real; 3],
+    /// Upper corner.
+    pub max: [Real; 3],
+    /// Particles per second.
+    pub rate: Real,
+    /// Total number to insert.
+    pub count: usize,
+    /// Initial velocity.
+    #[serde(default)]
+    pub velocity: [Real; 3],
+    /// Start time.
+    #[serde(default)]
+    pub start: Real,
+}
