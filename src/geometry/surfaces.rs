@@ -136,9 +136,6 @@ pub fn box_inside(
     for k in 0..3 {
         positive("max - min", max[k] - min[k])?;
     }
-    let c = |x: usize, y: usize, z: usize| {
-        Point3::new([min.x, max.x][x], [min.y, max.y][y], [min.z, max.z][z])
-    };
     let (x, y, z) = (
         Vector3::x() * (max.x - min.x),
         Vector3::y() * (max.y - min.y),
