@@ -42,12 +42,20 @@
 //! kept per contact pair and rotated into the current tangent plane every step), a
 //! dashpot on the tangential velocity, and the Coulomb cap `|F_t| ≤ μ |F_n|`; when
 //! sliding, the history is reset to the length that the cap allows.
+//!
+//! # Rocking damping and twisting friction
+//!
+//! The normal dashpot and the friction force act at one point and cannot resist a
+//! body rocking or twisting on a face about that point; [`rocking_damping`] and
+//! [`twisting_friction`] spread them over the contact area (see `area.rs`).
 
+mod area;
 mod damping;
 mod material;
 mod normal;
 mod tangential;
 
+pub use area::{rocking_damping, twisting_friction};
 pub use damping::DampingTable;
 pub use material::{Material, MaterialError, PairStiffness};
 pub use normal::{NormalContact, NormalForce, normal_force};

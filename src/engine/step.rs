@@ -11,7 +11,10 @@ use rayon::prelude::*;
 use super::broad_phase::BroadPhase;
 use super::integrate::{RotationState, free_rotation, half_kick};
 use crate::Real;
-use crate::contact::{DampingTable, NormalContact, PairStiffness, normal_force, tangential_force};
+use crate::contact::{
+    DampingTable, NormalContact, PairStiffness, normal_force, rocking_damping, tangential_force,
+    twisting_friction,
+};
 use crate::geometry::Shape;
 use crate::geometry::overlap::overlap;
 use crate::geometry::sphere::{sphere_polyhedron, sphere_sphere, sphere_triangle};
@@ -40,6 +43,8 @@ struct ContactForce {
     /// Torque on body 2 about its centroid.
     torque: Vector3<Real>,
     history: Vector3<Real>,
+    /// Elastic energy stored in the contact's normal law.
+    energy: Real,
 }
 
 impl ContactForce {
@@ -70,6 +75,9 @@ pub struct Engine {
     damping: HashMap<u64, DampingTable>,
     /// Number of particle–particle and particle–wall contacts in the last step.
     pub contacts: usize,
+    /// Elastic energy stored in all contacts' normal laws at the last force
+    /// evaluation (the potential of the overlap volumes).
+    pub elastic_energy: Real,
 }
 
 impl Engine {
@@ -84,7 +92,13 @@ impl Engine {
             wall_history: HashMap::new(),
             damping: HashMap::new(),
             contacts: 0,
+            elastic_energy: 0.0,
         }
+    }
+
+    /// Candidate particle pairs (bounding spheres overlapping) of the last step.
+    pub fn candidate_pairs(&self) -> usize {
+        self.pairs.len()
     }
 
     /// Computes the forces of the current state (call once before the first step).
@@ -176,10 +190,12 @@ impl Engine {
             .collect();
         let mut next_history = HashMap::with_capacity(results.len());
         let mut contacts = 0;
+        let mut energy = 0.0;
         for (&[i, j], r) in self.pairs.iter().zip(&results) {
             let Some(c) = r else { continue };
             let (i, j) = (i as usize, j as usize);
             contacts += 1;
+            energy += c.energy;
             let p = &mut world.particles;
             p.force[j] += c.force;
             p.force[i] -= c.force;
@@ -208,6 +224,7 @@ impl Engine {
             } in list
             {
                 contacts += 1;
+                energy += c.energy;
                 let p = &mut world.particles;
                 p.force[i] += c.force;
                 p.torque[i] += c.torque;
@@ -227,6 +244,7 @@ impl Engine {
         }
         self.wall_history = next_wall_history;
         self.contacts = contacts;
+        self.elastic_energy = energy;
     }
 }
 
@@ -344,12 +362,24 @@ fn pair_geometry(world: &World, i: usize, j: usize) -> Option<ContactGeometry> {
     }
 }
 
+/// How body 2 moves relative to body 1 at a contact, and how hard it is to move.
+#[derive(Clone, Copy, Debug)]
+struct RelativeMotion {
+    /// Velocity at the contact point.
+    velocity: Vector3<Real>,
+    /// Angular velocity.
+    spin: Vector3<Real>,
+    /// Inverse effective mass at the contact point along the normal.
+    inverse_mass: Real,
+    /// Effective moment of inertia `1/(1/I₁ + 1/I₂)` (smallest principal moments).
+    inertia: Real,
+}
+
 /// Normal and tangential force on body 2 of a contact.
 #[allow(clippy::too_many_arguments)]
 fn contact_force(
     g: &ContactGeometry,
-    relative_velocity: Vector3<Real>,
-    inverse_mass: Real,
+    motion: &RelativeMotion,
     stiffness: PairStiffness,
     damping: &DampingTable,
     friction: Real,
@@ -358,7 +388,8 @@ fn contact_force(
     centre: &Point3<Real>,
     dt: Real,
 ) -> ContactForce {
-    let effective_mass = 1.0 / inverse_mass;
+    let relative_velocity = motion.velocity;
+    let effective_mass = 1.0 / motion.inverse_mass;
     let normal = normal_force(
         &NormalContact {
             volume: g.volume,
@@ -385,19 +416,44 @@ fn contact_force(
         friction * normal.force.norm(),
     );
     let force = normal.force + t.force;
-    let torque = match g.rotation_gradient {
-        // Elastic part from the potential (U' = elastic / area); damping and friction,
-        // measured at the contact point, act there.
-        Some(rotation) if g.area > 0.0 => {
-            let elastic = g.normal * normal.elastic;
-            -(normal.elastic / g.area) * rotation + (g.point - centre).cross(&(force - elastic))
-        }
-        _ => (g.point - centre).cross(&force),
+    let rocking = if g.depth > 0.0 {
+        rocking_damping(
+            &motion.spin,
+            &g.normal,
+            g.area,
+            normal.exponent * normal.elastic / g.depth,
+            motion.inertia,
+            damping.zeta(1.0),
+            dt,
+        )
+    } else {
+        Vector3::zeros()
     };
+    let twisting = twisting_friction(
+        &motion.spin,
+        &g.normal,
+        g.area,
+        kt,
+        motion.inertia,
+        friction * normal.force.norm(),
+        dt,
+    );
+    let torque = rocking
+        + twisting
+        + match g.rotation_gradient {
+            // Elastic part from the potential (U' = elastic / area); damping and friction,
+            // measured at the contact point, act there.
+            Some(rotation) if g.area > 0.0 => {
+                let elastic = g.normal * normal.elastic;
+                -(normal.elastic / g.area) * rotation + (g.point - centre).cross(&(force - elastic))
+            }
+            _ => (g.point - centre).cross(&force),
+        };
     ContactForce {
         force,
         torque,
         history: t.history,
+        energy: normal.energy,
     }
 }
 
@@ -425,17 +481,20 @@ fn pair_force(
     // The pair's restitution and friction: the means of the two materials'.
     let e = pair_restitution(mi.restitution, mj.restitution);
     let table = damping_table(damping, e);
-    let rel_v = velocity_at(world, j, &g.point) - velocity_at(world, i, &g.point);
-    let inv_m = inverse_mass_at(world, i, &g.point, &g.normal)
-        + inverse_mass_at(world, j, &g.point, &g.normal);
+    let motion = RelativeMotion {
+        velocity: velocity_at(world, j, &g.point) - velocity_at(world, i, &g.point),
+        spin: world.angular_velocity(j) - world.angular_velocity(i),
+        inverse_mass: inverse_mass_at(world, i, &g.point, &g.normal)
+            + inverse_mass_at(world, j, &g.point, &g.normal),
+        inertia: 1.0 / (1.0 / ti.inertia.min() + 1.0 / tj.inertia.min()),
+    };
     let h = history
         .get(&(p.id[i], p.id[j]))
         .copied()
         .unwrap_or_default();
     Some(contact_force(
         &g,
-        rel_v,
-        inv_m,
+        &motion,
         stiffness,
         &table,
         0.5 * (mi.friction + mj.friction),
@@ -570,14 +629,17 @@ fn wall_contacts(
             if !(g.area > 0.0) || !g.normal.iter().all(|x| x.is_finite()) {
                 continue;
             }
-            let rel_v = velocity_at(world, i, &g.point) - wall.velocity_at(&g.point);
-            let inv_m = inverse_mass_at(world, i, &g.point, &g.normal);
+            let motion = RelativeMotion {
+                velocity: velocity_at(world, i, &g.point) - wall.velocity_at(&g.point),
+                spin: world.angular_velocity(i) - wall.angular_velocity,
+                inverse_mass: inverse_mass_at(world, i, &g.point, &g.normal),
+                inertia: t.inertia.min(),
+            };
             let wall_key = (p.id[i], w as u32, key);
             let h = history.get(&wall_key).copied().unwrap_or_default();
             let c = contact_force(
                 &g,
-                rel_v,
-                inv_m,
+                &motion,
                 stiffness,
                 &table,
                 0.5 * (pm.friction + wm.friction),

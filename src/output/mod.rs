@@ -87,6 +87,8 @@ pub struct RunOutput {
     /// Per wall: impulse, angular impulse, work delivered, since the last row.
     impulses: Vec<[Vector3<Real>; 2]>,
     work: Vec<Real>,
+    rows: usize,
+    last_frame: Option<Real>,
 }
 
 impl RunOutput {
@@ -124,6 +126,8 @@ impl RunOutput {
             last_row: world.time,
             impulses: vec![[Vector3::zeros(); 2]; world.walls.len()],
             work: vec![0.0; world.walls.len()],
+            rows: 0,
+            last_frame: None,
         })
     }
 
@@ -144,7 +148,6 @@ impl RunOutput {
         world: &World,
         dt: Real,
         contacts: usize,
-        max_speed: Real,
         force: bool,
     ) -> io::Result<()> {
         for (k, w) in world.walls.iter().enumerate() {
@@ -154,8 +157,12 @@ impl RunOutput {
         }
         let t = world.time;
         let eps = 1e-9 * dt;
-        if force || self.csv_interval.is_some_and(|_| t >= self.next_row - eps) {
-            self.write_rows(world, contacts, max_speed)?;
+        // A forced record at a time already written (the end of a run that landed on
+        // a row or frame) writes nothing twice.
+        let rows_due = self.csv_interval.is_some_and(|_| t >= self.next_row - eps)
+            || (force && (t > self.last_row || self.rows == 0));
+        if rows_due {
+            self.write_rows(world, contacts)?;
             if let Some(i) = self.csv_interval {
                 while self.next_row <= t + eps {
                     self.next_row += i;
@@ -177,8 +184,14 @@ impl RunOutput {
         Ok(())
     }
 
-    fn write_rows(&mut self, world: &World, contacts: usize, max_speed: Real) -> io::Result<()> {
+    fn write_rows(&mut self, world: &World, contacts: usize) -> io::Result<()> {
         let t = world.time;
+        let max_speed = world
+            .particles
+            .velocity
+            .iter()
+            .map(|v| v.norm())
+            .fold(0.0, Real::max);
         let span = t - self.last_row;
         let mut row = format!("{t:.9e}");
         for (k, w) in world.walls.iter().enumerate() {
@@ -210,12 +223,14 @@ impl RunOutput {
             world.kinetic_energy()
         )?;
         self.last_row = t;
+        self.rows += 1;
         self.walls_csv.flush()?;
         self.series_csv.flush()
     }
 
     fn write_frame(&mut self, world: &World) -> io::Result<()> {
         let k = self.particles.len();
+        self.last_frame = Some(world.time);
         let p = format!("frames/particles_{k:06}.vtp");
         let w = format!("frames/walls_{k:06}.vtp");
         vtk::write_particles(world, &self.dir.join(&p))?;

@@ -1,5 +1,6 @@
 //! The `talus` command line.
 
+mod bench;
 mod contact;
 mod run;
 
@@ -47,6 +48,16 @@ enum Command {
         /// A TOML file with two [[body]] entries.
         file: PathBuf,
     },
+    /// Measure whole-step throughput (particle-steps/s, contacts/s) on a dense bed of
+    /// dodecahedra and on spheres in an STL box, on 1 and 2 threads.
+    Bench {
+        /// Scale of the particle counts (1: 10 000 dodecahedra and 5000 spheres).
+        #[arg(long, default_value_t = 1.0)]
+        scale: f64,
+        /// Timed steps per run.
+        #[arg(long, default_value_t = 200)]
+        steps: usize,
+    },
     /// Check a particle mesh (STL or OBJ) and print its mass properties.
     Inspect {
         /// The mesh file.
@@ -77,6 +88,7 @@ fn main() -> Result<()> {
             },
         ),
         Command::Contact { file } => contact::contact(&file),
+        Command::Bench { scale, steps } => bench::bench(bench::BenchOptions { scale, steps }),
         Command::Inspect { mesh, hull, scale } => {
             let spec = ShapeSpec::Mesh {
                 file: mesh.clone(),

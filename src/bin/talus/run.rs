@@ -79,13 +79,7 @@ fn run_loop(
         scene.spec.output.csv_interval,
     )
     .with_context(|| format!("cannot write to {}", dir.display()))?;
-    out.record(
-        &sim.world,
-        scene.dt,
-        sim.engine.contacts,
-        sim.max_speed(),
-        true,
-    )?;
+    out.record(&sim.world, scene.dt, sim.engine.contacts, true)?;
     let total_steps = (sim.end_time / scene.dt).ceil() as u64;
     let bar = if quiet {
         ProgressBar::hidden()
@@ -120,7 +114,7 @@ fn run_loop(
         sim.step();
         sim.engine.dt = dt;
         contact_sum += sim.engine.contacts as u64;
-        out.record(&sim.world, dt, sim.engine.contacts, 0.0, false)?;
+        out.record(&sim.world, dt, sim.engine.contacts, false)?;
         if last_draw.elapsed() > Duration::from_millis(200) {
             last_draw = Instant::now();
             bar.set_position(sim.steps);
@@ -133,13 +127,7 @@ fn run_loop(
         }
     };
     bar.finish_and_clear();
-    out.record(
-        &sim.world,
-        scene.dt,
-        sim.engine.contacts,
-        sim.max_speed(),
-        true,
-    )?;
+    out.record(&sim.world, scene.dt, sim.engine.contacts, true)?;
     let elapsed = started.elapsed().as_secs_f64();
     let report = sim.report();
     let summary = Summary {

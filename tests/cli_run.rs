@@ -1,0 +1,195 @@
+//! `talus check` and `talus run`: the plan is printed, a run leaves a ParaView series,
+//! CSV series and a summary, and an interrupted run still leaves valid outputs.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+const SCENE: &str = r#"
+[simulation]
+dt = 2e-6
+end_time = END
+gravity = [0.0, 0.0, -9.81]
+
+[contact]
+regularisation = 0.2
+
+[output]
+frame_interval = 0.001
+
+[materials.pla]
+density = 1500.0
+young = 1e6
+poisson = 0.1
+restitution = 0.3
+friction = 0.5
+
+[shapes.dodecahedron]
+kind = "platonic"
+solid = "dodecahedron"
+circumradius = 0.005
+
+[[wall]]
+name = "box"
+material = "pla"
+geometry = { kind = "box", min = [0.0, 0.0, 0.0], max = [0.04, 0.04, 0.1], open_top = true }
+
+[[wall]]
+name = "lid"
+material = "pla"
+geometry = { kind = "plane", centre = [0.02, 0.02, 0.09], normal = [0.0, 0.0, -1.0], size = 0.04 }
+motion = { kind = "linear", velocity = [0.0, 0.0, -0.5] }
+
+[[particles]]
+kind = "lattice"
+shape = "dodecahedron"
+material = "pla"
+min = [0.0, 0.0, 0.0]
+max = [0.04, 0.04, 0.04]
+"#;
+
+fn write_scene(dir: &Path, end: &str) -> PathBuf {
+    std::fs::create_dir_all(dir).unwrap();
+    let path = dir.join("scene.toml");
+    std::fs::write(&path, SCENE.replace("END", end)).unwrap();
+    path
+}
+
+fn talus() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_talus"))
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);
+    let _ = std::fs::remove_dir_all(&dir);
+    dir
+}
+
+#[test]
+fn check_prints_the_plan() {
+    let dir = scratch("check");
+    let scene = write_scene(&dir, "0.01");
+    let out = talus().arg("check").arg(&scene).output().unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(text.contains("valid scene"));
+    assert!(text.contains("particles: 27 at start"), "{text}");
+    assert!(text.contains("polyhedron–polyhedron"), "{text}");
+    assert!(text.contains("wall 'lid': 2 facets"), "{text}");
+    assert!(
+        text.contains("wall kinematics: advanced every step"),
+        "{text}"
+    );
+    // A broken scene: non-zero exit, the message names file, line and field.
+    std::fs::write(dir.join("bad.toml"), SCENE.replace("END", "-1")).unwrap();
+    let out = talus()
+        .arg("check")
+        .arg(dir.join("bad.toml"))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(
+        err.contains("bad.toml:4:") && err.contains("simulation.end_time"),
+        "{err}"
+    );
+}
+
+#[test]
+fn run_writes_the_series_and_the_summary() {
+    let dir = scratch("run");
+    let scene = write_scene(&dir, "0.005");
+    let out_dir = dir.join("out");
+    let out = talus()
+        .args(["run", "--quiet", "--threads", "2", "--out"])
+        .arg(&out_dir)
+        .arg(&scene)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out_dir.join("summary.json")).unwrap())
+            .unwrap();
+    assert_eq!(summary["ended_by"], "end_time");
+    assert!((summary["time"].as_f64().unwrap() - 0.005).abs() < 1e-12);
+    assert_eq!(summary["steps"], 2500);
+    assert_eq!(summary["particles"], 27);
+    assert_eq!(summary["threads"], 2);
+    // Frames at 0, 1, ..., 5 ms and the final one.
+    let pvd = std::fs::read_to_string(out_dir.join("particles.pvd")).unwrap();
+    let frames = pvd.matches("<DataSet").count();
+    assert!((6..=7).contains(&frames), "{frames} frames");
+    let vtp = std::fs::read(out_dir.join("frames/particles_000000.vtp")).unwrap();
+    let head = String::from_utf8_lossy(&vtp[..600.min(vtp.len())]);
+    // 27 dodecahedra of 12 pentagons, 5 points each.
+    assert!(
+        head.contains("NumberOfPoints=\"1620\"") && head.contains("NumberOfPolys=\"324\""),
+        "{head}"
+    );
+    assert!(head.contains("Name=\"velocity\""));
+    assert!(out_dir.join("frames/walls_000000.vtp").exists());
+    let walls = std::fs::read_to_string(out_dir.join("walls.csv")).unwrap();
+    let header = walls.lines().next().unwrap();
+    assert!(
+        header.starts_with("time,box_fx,box_fy,box_fz,box_tx,box_ty,box_tz,box_power,lid_fx"),
+        "{header}"
+    );
+    // The particles rest on the box floor under gravity: the mean vertical force on
+    // the box approaches their weight (27 × m g) once settled; here, early, it is at
+    // least positive downward on average.
+    let rows: Vec<Vec<f64>> = walls
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+        .collect();
+    assert!(rows.len() >= 6);
+    assert!(rows.iter().all(|r| r.iter().all(|x| x.is_finite())));
+}
+
+#[test]
+fn an_interrupted_run_leaves_valid_outputs() {
+    let dir = scratch("interrupt");
+    let scene = write_scene(&dir, "100.0");
+    let out_dir = dir.join("out");
+    let mut child = talus()
+        .args(["run", "--quiet", "--out"])
+        .arg(&out_dir)
+        .arg(&scene)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Wait for the first frame, then interrupt.
+    let start = Instant::now();
+    while !out_dir.join("particles.pvd").exists() {
+        assert!(start.elapsed() < Duration::from_secs(60));
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    std::thread::sleep(Duration::from_millis(500));
+    let status = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let out = child.wait_with_output().unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out_dir.join("summary.json")).unwrap())
+            .unwrap();
+    assert_eq!(summary["ended_by"], "interrupted");
+    assert!(summary["time"].as_f64().unwrap() < 100.0);
+    let pvd = std::fs::read_to_string(out_dir.join("particles.pvd")).unwrap();
+    assert!(pvd.trim_end().ends_with("</VTKFile>"));
+}
