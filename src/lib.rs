@@ -7,8 +7,14 @@
 //!   mesh loading, GJK, exact overlap volume, polyhedron–triangle and sphere contact
 //!   kernels. It knows nothing of time, forces or scenes.
 //!
-//! Higher layers (contact laws, world state, engine, scene files, co-simulation and
-//! transports) build on it.
+//! - [`contact`]: contact geometry and relative motion to forces and torques.
+//! - [`world`]: particles in flat arrays, body types, materials, walls with their
+//!   motion, inlets.
+//! - [`engine`]: the CPU time step (broad phase, narrow phase, accumulation,
+//!   integration) and the suggested time step.
+//! - [`scene`]: TOML scene files, validated with errors that name file, line and
+//!   field, built into a world and run as a [`scene::Simulation`].
+//! - [`output`]: ParaView series, CSV time series, run summary.
 
 // `!(x > 0.0)` is how talus rejects NaN along with non-positive values; clippy's
 // rewrite to `partial_cmp` would hide that intent.
