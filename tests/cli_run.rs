@@ -159,7 +159,7 @@ fn an_interrupted_run_leaves_valid_outputs() {
     let dir = scratch("interrupt");
     let scene = write_scene(&dir, "100.0");
     let out_dir = dir.join("out");
-    let mut child = talus()
+    let child = talus()
         .args(["run", "--quiet", "--out"])
         .arg(&out_dir)
         .arg(&scene)
