@@ -6,7 +6,9 @@ mod common;
 
 use common::pose;
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
-use talus::contact::{DampingTable, NormalContact, normal_force, tangential_force};
+use talus::contact::{
+    DampingTable, NormalContact, TangentialHistory, normal_force, tangential_force,
+};
 use talus::geometry::ConvexPolyhedron;
 use talus::geometry::generators;
 use talus::geometry::overlap::overlap;
@@ -202,8 +204,12 @@ fn coulomb_friction_sticks_slides_and_carries_its_history() {
     let n = Vector3::z();
     let (k, c, dt) = (1e4, 0.0, 1e-4);
     // Sticking: the spring grows with the tangential displacement.
+    let spring = |v: Vector3<f64>| TangentialHistory {
+        spring: v,
+        stiffness: k,
+    };
     let t = tangential_force(
-        &Vector3::zeros(),
+        &TangentialHistory::default(),
         &n,
         &Vector3::new(0.1, 0.0, -0.3),
         dt,
@@ -212,12 +218,12 @@ fn coulomb_friction_sticks_slides_and_carries_its_history() {
         1.0,
     );
     assert!(!t.sliding);
-    assert!((t.history - Vector3::new(1e-5, 0.0, 0.0)).norm() < 1e-18);
+    assert!((t.history.spring - Vector3::new(1e-5, 0.0, 0.0)).norm() < 1e-18);
     assert!((t.force - Vector3::new(-0.1, 0.0, 0.0)).norm() < 1e-12);
     // Sliding: the force is capped at the limit and the spring shrinks to the length
     // whose force is the cap.
     let t = tangential_force(
-        &Vector3::new(1e-3, 0.0, 0.0),
+        &spring(Vector3::new(1e-3, 0.0, 0.0)),
         &n,
         &Vector3::new(1.0, 0.0, 0.0),
         dt,
@@ -227,18 +233,26 @@ fn coulomb_friction_sticks_slides_and_carries_its_history() {
     );
     assert!(t.sliding);
     assert!((t.force.norm() - 2.0).abs() < 1e-12 && t.force.x < 0.0);
-    assert!((k * t.history.norm() - 2.0).abs() < 1e-12);
+    assert!((k * t.history.spring.norm() - 2.0).abs() < 1e-12);
     // A dashpot stronger than the cap slides the contact but must not lengthen the
     // spring: sliding stores no energy.
     let short = Vector3::new(1e-6, 0.0, 0.0);
-    let t = tangential_force(&short, &n, &Vector3::new(1.0, 0.0, 0.0), dt, k, 50.0, 2.0);
+    let t = tangential_force(
+        &spring(short),
+        &n,
+        &Vector3::new(1.0, 0.0, 0.0),
+        dt,
+        k,
+        50.0,
+        2.0,
+    );
     assert!(t.sliding && (t.force.norm() - 2.0).abs() < 1e-12);
-    assert!((t.history - (short + Vector3::new(1e-4, 0.0, 0.0))).norm() < 1e-18);
+    assert!((t.history.spring - (short + Vector3::new(1e-4, 0.0, 0.0))).norm() < 1e-18);
     // A history from a turned contact frame is rotated into the new tangent plane
     // with its length kept.
     let tilted = Vector3::new(0.0, 1.0, 1.0).normalize();
     let t = tangential_force(
-        &Vector3::new(0.0, 3e-5, 0.0),
+        &spring(Vector3::new(0.0, 3e-5, 0.0)),
         &tilted,
         &Vector3::zeros(),
         dt,
@@ -246,6 +260,6 @@ fn coulomb_friction_sticks_slides_and_carries_its_history() {
         c,
         10.0,
     );
-    assert!((t.history.norm() - 3e-5).abs() < 1e-18);
-    assert!(t.history.dot(&tilted).abs() < 1e-18);
+    assert!((t.history.spring.norm() - 3e-5).abs() < 1e-18);
+    assert!(t.history.spring.dot(&tilted).abs() < 1e-18);
 }

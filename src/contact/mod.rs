@@ -59,4 +59,4 @@ pub use area::{rocking_damping, twisting_friction};
 pub use damping::DampingTable;
 pub use material::{Material, MaterialError, PairStiffness};
 pub use normal::{NormalContact, NormalForce, normal_force};
-pub use tangential::{TangentialForce, tangential_force};
+pub use tangential::{TangentialForce, TangentialHistory, tangential_force};

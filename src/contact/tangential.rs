@@ -4,14 +4,22 @@ use nalgebra::Vector3;
 
 use crate::Real;
 
+/// What a contact keeps of its friction spring from step to step.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TangentialHistory {
+    /// Accumulated tangential displacement (in the tangent plane of its step).
+    pub spring: Vector3<Real>,
+    /// The spring constant it was stretched at (N/m).
+    pub stiffness: Real,
+}
+
 /// The tangential force on body 2 and the updated history.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TangentialForce {
     /// Tangential force on body 2.
     pub force: Vector3<Real>,
-    /// Accumulated tangential displacement to keep for the next step (in the current
-    /// tangent plane).
-    pub history: Vector3<Real>,
+    /// The spring to keep for the next step.
+    pub history: TangentialHistory,
     /// Whether the contact slides (the Coulomb cap is active).
     pub sliding: bool,
 }
@@ -28,8 +36,16 @@ pub struct TangentialForce {
 /// When the trial force exceeds the cap the force is the cap along the trial
 /// direction, and the spring is shortened (never lengthened) to the length whose force
 /// is the cap, so that sliding never stores energy in the spring.
+///
+/// The spring constant follows the contact area, which changes with the normal load.
+/// A spring kept as a displacement would then store energy from nothing when the
+/// constant grows (`½ k s²` at fixed `s`), and one kept as a force when it shrinks
+/// (`F² / 2k` at fixed `F`); both pump energy into a pile whose contact loads
+/// fluctuate. So a stiffer spring keeps its force (the displacement is scaled by
+/// `k_old / k_new`) and a softer one keeps its displacement: the stored energy never
+/// grows by a change of stiffness.
 pub fn tangential_force(
-    history: &Vector3<Real>,
+    history: &TangentialHistory,
     normal: &Vector3<Real>,
     relative_velocity: &Vector3<Real>,
     dt: Real,
@@ -37,8 +53,14 @@ pub fn tangential_force(
     damping: Real,
     limit: Real,
 ) -> TangentialForce {
-    let length = history.norm();
-    let mut spring = history - normal * normal.dot(history);
+    let previous = &history.spring;
+    let mut length = previous.norm();
+    if history.stiffness > stiffness.max(0.0) || history.stiffness <= 0.0 {
+        // Softer (or new): keep the displacement.
+    } else {
+        length *= history.stiffness / stiffness;
+    }
+    let mut spring = previous - normal * normal.dot(previous);
     let projected = spring.norm();
     if projected > 0.0 {
         spring *= length / projected;
@@ -50,7 +72,7 @@ pub fn tangential_force(
     if magnitude <= limit || magnitude == 0.0 {
         return TangentialForce {
             force: trial,
-            history: spring,
+            history: TangentialHistory { spring, stiffness },
             sliding: false,
         };
     }
@@ -62,14 +84,41 @@ pub fn tangential_force(
     // dashpot into the spring, `-(F + c v_t)/k`, is worse: the spring then points along
     // the motion.)
     let length = spring.norm();
-    let history = if stiffness > 0.0 && stiffness * length > limit {
+    let spring = if stiffness > 0.0 && stiffness * length > limit {
         spring * (limit / (stiffness * length))
     } else {
         spring
     };
+    let history = TangentialHistory { spring, stiffness };
     TangentialForce {
         force,
         history,
         sliding: true,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A stuck contact whose stiffness swings up and down at rest stores no energy
+    /// from the swings: its spring energy never exceeds what it started with.
+    #[test]
+    fn a_changing_stiffness_never_adds_spring_energy() {
+        let n = Vector3::z();
+        let mut h = TangentialHistory {
+            spring: Vector3::new(1e-5, 0.0, 0.0),
+            stiffness: 1e4,
+        };
+        let energy = |h: &TangentialHistory| 0.5 * h.stiffness * h.spring.norm_squared();
+        let start = energy(&h);
+        let mut highest: Real = 0.0;
+        for step in 0..1000 {
+            let k = 1e4 * (1.0 + 0.9 * (step as Real * 0.1).sin());
+            let t = tangential_force(&h, &n, &Vector3::zeros(), 1e-4, k, 0.0, 1e3);
+            h = t.history;
+            highest = highest.max(energy(&h));
+        }
+        assert!(highest <= start * (1.0 + 1e-12), "{highest} > {start}");
     }
 }

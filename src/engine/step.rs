@@ -12,8 +12,8 @@ use super::broad_phase::BroadPhase;
 use super::integrate::{RotationState, free_rotation, half_kick};
 use crate::Real;
 use crate::contact::{
-    DampingTable, NormalContact, PairStiffness, normal_force, rocking_damping, tangential_force,
-    twisting_friction,
+    DampingTable, NormalContact, PairStiffness, TangentialHistory, normal_force, rocking_damping,
+    tangential_force, twisting_friction,
 };
 use crate::geometry::Shape;
 use crate::geometry::overlap::overlap;
@@ -42,7 +42,7 @@ struct ContactForce {
     force: Vector3<Real>,
     /// Torque on body 2 about its centroid.
     torque: Vector3<Real>,
-    history: Vector3<Real>,
+    history: TangentialHistory,
     /// Elastic energy stored in the contact's normal law.
     energy: Real,
 }
@@ -70,8 +70,8 @@ pub struct Engine {
     pub regularisation_length: Real,
     broad: BroadPhase,
     pairs: Vec<[u32; 2]>,
-    history: HashMap<(u64, u64), Vector3<Real>>,
-    wall_history: HashMap<WallKey, Vector3<Real>>,
+    history: HashMap<(u64, u64), TangentialHistory>,
+    wall_history: HashMap<WallKey, TangentialHistory>,
     damping: HashMap<u64, DampingTable>,
     /// Number of particle–particle and particle–wall contacts in the last step.
     pub contacts: usize,
@@ -201,7 +201,7 @@ impl Engine {
             p.force[i] -= c.force;
             p.torque[j] += c.torque;
             p.torque[i] += c.reaction_torque(&p.position[i], &p.position[j]);
-            if c.history != Vector3::zeros() {
+            if c.history.spring != Vector3::zeros() {
                 next_history.insert((p.id[i], p.id[j]), c.history);
             }
         }
@@ -237,7 +237,7 @@ impl Engine {
                         wall.facet_force[f as usize] -= c.force * (share / total);
                     }
                 }
-                if c.history != Vector3::zeros() {
+                if c.history.spring != Vector3::zeros() {
                     next_wall_history.insert(key, c.history);
                 }
             }
@@ -383,7 +383,7 @@ fn contact_force(
     stiffness: PairStiffness,
     damping: &DampingTable,
     friction: Real,
-    history: Vector3<Real>,
+    history: TangentialHistory,
     regularisation: Real,
     centre: &Point3<Real>,
     dt: Real,
@@ -461,7 +461,7 @@ fn pair_force(
     world: &World,
     i: usize,
     j: usize,
-    history: &HashMap<(u64, u64), Vector3<Real>>,
+    history: &HashMap<(u64, u64), TangentialHistory>,
     damping: &HashMap<u64, DampingTable>,
     law: &LawParams,
 ) -> Option<ContactForce> {
@@ -525,7 +525,7 @@ struct WallContact {
 fn wall_contacts(
     world: &World,
     i: usize,
-    history: &HashMap<WallKey, Vector3<Real>>,
+    history: &HashMap<WallKey, TangentialHistory>,
     damping: &HashMap<u64, DampingTable>,
     law: &LawParams,
 ) -> Vec<WallContact> {
