@@ -29,12 +29,10 @@
 //! point either: a polyhedron that lands with a twist on a face keeps turning on it
 //! (observed: 0.88 rad/s, undamped). Coulomb tractions spread over a disc of area `A`
 //! under a uniform pressure resist twisting with at most `M = μ F_n · ⅔ √(A/π)`.
-//! [`twisting_friction`] applies a viscous torque of the damping a ring of tangential
-//! springs `k_t` over the area would have at ζ = 1 (`k_twist = k_t A / 2π`), capped
-//! by that Coulomb moment and by what stops the relative twist within one step. It
-//! holds no history: a steady external torque about the normal below the Coulomb
-//! moment makes the contact creep slowly instead of sticking, which no scene of talus
-//! relies on.
+//! [`twisting_friction`] puts a torsional spring (the tangential springs `k_t` spread
+//! over the area, `k_twist = k_t A / 2π`) with a dashpot at ζ = 1 on the accumulated
+//! twist, capped by that Coulomb moment, so a twisted contact sticks under a steady
+//! torque as the tangential spring does under a steady force.
 
 use nalgebra::Vector3;
 
@@ -68,14 +66,23 @@ pub fn rocking_damping(
     -rocking * coefficient
 }
 
-/// Twisting-friction torque on body 2 (body 1 gets the opposite).
+/// Twisting friction: the torque on body 2 (body 1 gets the opposite) and the twist
+/// to keep for the next step.
 ///
-/// `spin` is body 2's angular velocity relative to body 1, `normal` the unit contact
-/// normal, `area` the contact area, `tangential_stiffness` the tangential spring
-/// constant of the contact (N/m), `inertia` the effective moment of inertia,
-/// `coulomb` the friction limit `μ F_n` (N), `dt` the time step (0 for no cap).
+/// `twist` is the accumulated relative twist (rad) from the previous step, `spin`
+/// body 2's angular velocity relative to body 1, `normal` the unit contact normal,
+/// `area` the contact area, `tangential_stiffness` the tangential spring constant of
+/// the contact (N/m), `inertia` the effective moment of inertia, `coulomb` the
+/// friction limit `μ F_n` (N), `dt` the time step.
+///
+/// A torsional spring `k_tw = k_t A / 2π` (tangential springs spread over a disc of
+/// area `A`) on the accumulated twist, a dashpot at ζ = 1, and the Coulomb moment
+/// `μ F_n ⅔ √(A/π)` as the cap; while the cap is active the twist is shortened to what
+/// the cap allows, as for the tangential spring. The spring makes a twisted contact
+/// stick under a steady torque instead of creeping.
 #[allow(clippy::too_many_arguments)]
 pub fn twisting_friction(
+    twist: Real,
     spin: &Vector3<Real>,
     normal: &Vector3<Real>,
     area: Real,
@@ -83,19 +90,28 @@ pub fn twisting_friction(
     inertia: Real,
     coulomb: Real,
     dt: Real,
-) -> Vector3<Real> {
-    let twist = normal.dot(spin);
-    if !(area > 0.0 && tangential_stiffness > 0.0 && inertia > 0.0 && coulomb > 0.0) || twist == 0.0
-    {
-        return Vector3::zeros();
+) -> (Vector3<Real>, Real) {
+    if !(area > 0.0 && tangential_stiffness > 0.0 && inertia > 0.0 && coulomb > 0.0) {
+        return (Vector3::zeros(), 0.0);
     }
+    let rate = normal.dot(spin);
     let stiffness = tangential_stiffness * area / (2.0 * std::f64::consts::PI);
-    let mut magnitude = 2.0 * (inertia * stiffness).sqrt() * twist.abs();
-    magnitude = magnitude.min(coulomb * (2.0 / 3.0) * (area / std::f64::consts::PI).sqrt());
+    let mut damping = 2.0 * (inertia * stiffness).sqrt();
     if dt > 0.0 {
-        magnitude = magnitude.min(inertia * twist.abs() / dt);
+        damping = damping.min(inertia / dt);
     }
-    -normal * (magnitude * twist.signum())
+    let mut angle = twist + rate * dt;
+    let trial = -stiffness * angle - damping * rate;
+    let cap = coulomb * (2.0 / 3.0) * (area / std::f64::consts::PI).sqrt();
+    let moment = if trial.abs() <= cap {
+        trial
+    } else {
+        if stiffness * angle.abs() > cap {
+            angle *= cap / (stiffness * angle.abs());
+        }
+        cap * trial.signum()
+    };
+    (normal * moment, angle)
 }
 
 #[cfg(test)]
@@ -122,23 +138,34 @@ mod tests {
     }
 
     #[test]
-    fn twisting_friction_opposes_the_twist_up_to_the_coulomb_moment() {
+    fn twisting_friction_sticks_then_slides_at_the_coulomb_moment() {
         let n = Vector3::z();
+        let area: Real = 1e-4;
+        let (k, inertia, dt) = (1e3, 1e-9, 1e-5);
+        let k_tw = k * area / (2.0 * std::f64::consts::PI);
+        // Sticking: a spring on the accumulated twist, plus the dashpot.
         let spin = Vector3::new(3.0, 0.0, 2.0);
-        let area: f64 = 1e-4;
-        // Viscous below the cap: along −n, proportional to the twist.
-        let t = twisting_friction(&spin, &n, area, 1e3, 1e-9, 1.0, 0.0);
-        let c = 2.0 * (1e-9 * 1e3 * area / (2.0 * std::f64::consts::PI)).sqrt();
-        assert!((t.z + c * 2.0).abs() < 1e-12 * c);
+        let (t, angle) = twisting_friction(0.01, &spin, &n, area, k, inertia, 1.0, dt);
+        assert!((angle - (0.01 + 2.0 * dt)).abs() < 1e-15);
+        let c = (2.0 * (inertia * k_tw).sqrt()).min(inertia / dt);
+        assert!((t.z + k_tw * angle + c * 2.0).abs() < 1e-15);
         assert_eq!((t.x, t.y), (0.0, 0.0));
-        // Capped at μ F_n ⅔ √(A/π).
-        let t = twisting_friction(&spin, &n, area, 1e9, 1e-3, 1e-3, 0.0);
-        let cap = 1e-3 * (2.0 / 3.0) * (area / std::f64::consts::PI).sqrt();
-        assert!((t.z + cap).abs() < 1e-15);
-        // No friction, no torque.
+        // A twist held at rest keeps its torque (it sticks, no creep).
+        let (t2, angle2) =
+            twisting_friction(angle, &Vector3::zeros(), &n, area, k, inertia, 1.0, dt);
+        assert_eq!(angle2, angle);
+        assert!((t2.z + k_tw * angle).abs() < 1e-15);
+        // Beyond the Coulomb moment: capped, and the twist shortened to the cap.
+        let coulomb = 1e-6;
+        let cap = coulomb * (2.0 / 3.0) * (area / std::f64::consts::PI).sqrt();
+        let (t, angle) =
+            twisting_friction(10.0, &Vector3::zeros(), &n, area, k, inertia, coulomb, dt);
+        assert!((t.z + cap).abs() < 1e-18);
+        assert!((k_tw * angle - cap).abs() < 1e-15 * cap.max(1.0));
+        // No friction, no torque and no twist kept.
         assert_eq!(
-            twisting_friction(&spin, &n, area, 1e3, 1e-9, 0.0, 0.0),
-            Vector3::zeros()
+            twisting_friction(0.3, &spin, &n, area, k, inertia, 0.0, dt),
+            (Vector3::zeros(), 0.0)
         );
     }
 }

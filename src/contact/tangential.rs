@@ -11,6 +11,16 @@ pub struct TangentialHistory {
     pub spring: Vector3<Real>,
     /// The spring constant it was stretched at (N/m).
     pub stiffness: Real,
+    /// Accumulated relative twist about the normal, rad (see
+    /// [`super::twisting_friction`]).
+    pub twist: Real,
+}
+
+impl TangentialHistory {
+    /// Whether there is nothing to keep.
+    pub fn is_empty(&self) -> bool {
+        self.spring == Vector3::zeros() && self.twist == 0.0
+    }
 }
 
 /// The tangential force on body 2 and the updated history.
@@ -72,7 +82,11 @@ pub fn tangential_force(
     if magnitude <= limit || magnitude == 0.0 {
         return TangentialForce {
             force: trial,
-            history: TangentialHistory { spring, stiffness },
+            history: TangentialHistory {
+                spring,
+                stiffness,
+                twist: history.twist,
+            },
             sliding: false,
         };
     }
@@ -89,7 +103,11 @@ pub fn tangential_force(
     } else {
         spring
     };
-    let history = TangentialHistory { spring, stiffness };
+    let history = TangentialHistory {
+        spring,
+        stiffness,
+        twist: history.twist,
+    };
     TangentialForce {
         force,
         history,
@@ -109,6 +127,7 @@ mod tests {
         let mut h = TangentialHistory {
             spring: Vector3::new(1e-5, 0.0, 0.0),
             stiffness: 1e4,
+            twist: 0.0,
         };
         let energy = |h: &TangentialHistory| 0.5 * h.stiffness * h.spring.norm_squared();
         let start = energy(&h);

@@ -201,7 +201,7 @@ impl Engine {
             p.force[i] -= c.force;
             p.torque[j] += c.torque;
             p.torque[i] += c.reaction_torque(&p.position[i], &p.position[j]);
-            if c.history.spring != Vector3::zeros() {
+            if !c.history.is_empty() {
                 next_history.insert((p.id[i], p.id[j]), c.history);
             }
         }
@@ -237,7 +237,7 @@ impl Engine {
                         wall.facet_force[f as usize] -= c.force * (share / total);
                     }
                 }
-                if c.history.spring != Vector3::zeros() {
+                if !c.history.is_empty() {
                     next_wall_history.insert(key, c.history);
                 }
             }
@@ -429,7 +429,8 @@ fn contact_force(
     } else {
         Vector3::zeros()
     };
-    let twisting = twisting_friction(
+    let (twisting, twist) = twisting_friction(
+        history.twist,
         &motion.spin,
         &g.normal,
         g.area,
@@ -452,7 +453,7 @@ fn contact_force(
     ContactForce {
         force,
         torque,
-        history: t.history,
+        history: TangentialHistory { twist, ..t.history },
         energy: normal.energy,
     }
 }
