@@ -65,9 +65,8 @@ pub fn tangential_force(
 ) -> TangentialForce {
     let previous = &history.spring;
     let mut length = previous.norm();
-    if history.stiffness > stiffness.max(0.0) || history.stiffness <= 0.0 {
-        // Softer (or new): keep the displacement.
-    } else {
+    // Stiffer: keep the force. Softer (or new): keep the displacement.
+    if history.stiffness > 0.0 && stiffness > history.stiffness {
         length *= history.stiffness / stiffness;
     }
     let mut spring = previous - normal * normal.dot(previous);

@@ -153,7 +153,7 @@ impl RunOutput {
         for (k, w) in world.walls.iter().enumerate() {
             self.impulses[k][0] += w.force * dt;
             self.impulses[k][1] += w.torque * dt;
-            self.work[k] -= (w.force.dot(&w.velocity) + w.torque.dot(&w.angular_velocity)) * dt;
+            self.work[k] += w.power() * dt;
         }
         let t = world.time;
         let eps = 1e-9 * dt;
@@ -186,12 +186,7 @@ impl RunOutput {
 
     fn write_rows(&mut self, world: &World, contacts: usize) -> io::Result<()> {
         let t = world.time;
-        let max_speed = world
-            .particles
-            .velocity
-            .iter()
-            .map(|v| v.norm())
-            .fold(0.0, Real::max);
+        let max_speed = world.max_speed();
         let span = t - self.last_row;
         let mut row = format!("{t:.9e}");
         for (k, w) in world.walls.iter().enumerate() {
@@ -203,11 +198,7 @@ impl RunOutput {
                     self.work[k] / span,
                 )
             } else {
-                (
-                    w.force,
-                    w.torque,
-                    -(w.force.dot(&w.velocity) + w.torque.dot(&w.angular_velocity)),
-                )
+                (w.force, w.torque, w.power())
             };
             for x in f.iter().chain(m.iter()).chain(std::iter::once(&p)) {
                 row.push_str(&format!(",{x:.9e}"));

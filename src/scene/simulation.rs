@@ -107,12 +107,7 @@ impl Simulation {
 
     /// Largest particle speed (translation).
     pub fn max_speed(&self) -> Real {
-        self.world
-            .particles
-            .velocity
-            .iter()
-            .map(|v| v.norm())
-            .fold(0.0, Real::max)
+        self.world.max_speed()
     }
 
     /// Whether every inlet has inserted all its particles.

@@ -119,6 +119,15 @@ impl World {
             .component_div(inertia)
     }
 
+    /// Largest particle speed (translation).
+    pub fn max_speed(&self) -> Real {
+        self.particles
+            .velocity
+            .iter()
+            .map(|v| v.norm())
+            .fold(0.0, Real::max)
+    }
+
     /// Total kinetic energy (translation and rotation).
     pub fn kinetic_energy(&self) -> Real {
         let p = &self.particles;

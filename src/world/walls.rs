@@ -118,6 +118,12 @@ impl Wall {
         self.triangles[f].map(|v| self.pose * self.vertices[v as usize])
     }
 
+    /// Power the wall delivers to the particles: minus the rate of work of the force
+    /// and torque they exert on it.
+    pub fn power(&self) -> Real {
+        -(self.force.dot(&self.velocity) + self.torque.dot(&self.angular_velocity))
+    }
+
     /// Velocity of the wall material at world point `x`.
     pub fn velocity_at(&self, x: &Point3<Real>) -> Vector3<Real> {
         self.velocity + self.angular_velocity.cross(&(x - self.reference()))
