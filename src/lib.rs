@@ -14,6 +14,9 @@
 //!   integration) and the suggested time step.
 //! - [`scene`]: TOML scene files, validated with errors that name file, line and
 //!   field, built into a world and run as a [`scene::Simulation`].
+//! - [`cosim`]: the co-simulation [`cosim::Component`] (FMI-style life cycle,
+//!   variable table, communication steps, saved states).
+//! - [`ffi`], [`fmi2`], [`fmi3`]: the C ABI over the component.
 //! - [`output`]: ParaView series, CSV time series, run summary.
 
 // `!(x > 0.0)` is how talus rejects NaN along with non-positive values; clippy's
@@ -21,6 +24,7 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod contact;
+pub mod cosim;
 pub mod engine;
 pub mod geometry;
 pub mod output;

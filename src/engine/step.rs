@@ -58,10 +58,20 @@ impl ContactForce {
 /// Key of a particle–wall contact patch: particle id, wall, and the patch plane
 /// (normal and offset rounded), so that friction history survives sliding from facet
 /// to facet of a flat wall.
-type WallKey = (u64, u32, [i64; 4]);
+pub type WallKey = (u64, u32, [i64; 4]);
+
+/// The tangential contact history of an engine, sorted by key: what must be saved
+/// with the particles for a run to continue bit for bit.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ContactHistory {
+    /// Particle pairs, keyed by the two particle ids.
+    pub pairs: Vec<((u64, u64), TangentialHistory)>,
+    /// Particle–wall patches.
+    pub walls: Vec<(WallKey, TangentialHistory)>,
+}
 
 /// The CPU engine: time step, contact history and reusable buffers.
-#[derive(Debug)]
+#[derive(Clone, Debug)]
 pub struct Engine {
     /// Time step.
     pub dt: Real,
@@ -99,6 +109,21 @@ impl Engine {
     /// Candidate particle pairs (bounding spheres overlapping) of the last step.
     pub fn candidate_pairs(&self) -> usize {
         self.pairs.len()
+    }
+
+    /// The tangential contact history, sorted by key.
+    pub fn history(&self) -> ContactHistory {
+        let mut pairs: Vec<_> = self.history.iter().map(|(k, h)| (*k, *h)).collect();
+        let mut walls: Vec<_> = self.wall_history.iter().map(|(k, h)| (*k, *h)).collect();
+        pairs.sort_by_key(|e| e.0);
+        walls.sort_by_key(|e| e.0);
+        ContactHistory { pairs, walls }
+    }
+
+    /// Replaces the tangential contact history (see [`Engine::history`]).
+    pub fn set_history(&mut self, history: ContactHistory) {
+        self.history = history.pairs.into_iter().collect();
+        self.wall_history = history.walls.into_iter().collect();
     }
 
     /// Computes the forces of the current state (call once before the first step).

@@ -573,6 +573,6 @@ fn motion(path: &FieldPath, m: &MotionSpec) -> Result<(WallMotion, Option<Point3
             }
             (WallMotion::Table(keys.clone()), None)
         }
-        MotionSpec::External => (WallMotion::External, None),
+        MotionSpec::External { input } => (WallMotion::External(*input), None),
     })
 }

@@ -14,6 +14,7 @@ mod plan;
 pub mod poses;
 mod simulation;
 pub mod spec;
+pub mod state;
 
 use std::path::{Path, PathBuf};
 
@@ -21,6 +22,7 @@ pub use error::{FieldError, FieldPath, FieldSegment, SceneError};
 pub use plan::Plan;
 pub use simulation::{Simulation, StepReport};
 pub use spec::SceneSpec;
+pub use state::{StateError, StateReader, StateWriter};
 
 use crate::Real;
 use crate::engine::time_step::{TimeStepEstimate, suggested_time_step};

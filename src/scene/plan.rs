@@ -7,7 +7,7 @@ use super::spec::SceneSpec;
 use crate::Real;
 use crate::engine::time_step::TimeStepEstimate;
 use crate::geometry::Shape;
-use crate::world::{Inlet, WallMotion, World};
+use crate::world::{DriveInput, Inlet, WallMotion, World};
 
 /// What a scene will compute.
 #[derive(Clone, Debug, Default)]
@@ -138,7 +138,12 @@ impl Plan {
                     format!("oscillation {:?} m at {frequency} Hz", amplitude.as_slice())
                 }
                 WallMotion::Table(k) => format!("time table of {} keys", k.len()),
-                WallMotion::External => "driven from outside".into(),
+                WallMotion::External(DriveInput::Velocity) => {
+                    "driven from outside (velocity inputs)".into()
+                }
+                WallMotion::External(DriveInput::Pose) => {
+                    "driven from outside (pose inputs)".into()
+                }
             };
             line(
                 format!("wall '{}': {} facets", w.name, w.triangles.len()),

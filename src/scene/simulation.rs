@@ -10,7 +10,7 @@ use crate::engine::step::Engine;
 use crate::world::{Inlet, World};
 
 /// A scene being simulated.
-#[derive(Debug)]
+#[derive(Clone, Debug)]
 pub struct Simulation {
     /// The state.
     pub world: World,
@@ -22,9 +22,9 @@ pub struct Simulation {
     pub steps: u64,
     /// End time of the run.
     pub end_time: Real,
-    next_id: u64,
+    pub(super) next_id: u64,
     settle: Option<SettleSpec>,
-    quiet_since: Option<Real>,
+    pub(super) quiet_since: Option<Real>,
 }
 
 /// Figures of the state after a step.

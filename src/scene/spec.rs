@@ -11,7 +11,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::Real;
 use crate::geometry::ShapeSpec;
-use crate::world::MotionKey;
+use crate::world::{DriveInput, MotionKey};
 
 /// The whole scene file.
 #[derive(Clone, Debug, Deserialize, Serialize)]
@@ -334,7 +334,11 @@ pub enum MotionSpec {
         keys: Vec<MotionKey>,
     },
     /// Driven from outside (co-simulation inputs), at rest until set.
-    External,
+    External {
+        /// What the master gives: `velocity` (default) or `pose`.
+        #[serde(default)]
+        input: DriveInput,
+    },
 }
 
 /// `[[particles]]`: particles present at the start.

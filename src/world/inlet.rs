@@ -65,6 +65,17 @@ impl Inlet {
         }
     }
 
+    /// The state of the inlet's random generator, as bytes.
+    pub fn rng_state(&self) -> Vec<u8> {
+        serde_json::to_vec(&self.rng).expect("a PCG state always serialises")
+    }
+
+    /// Restores a state from [`Inlet::rng_state`].
+    pub fn set_rng_state(&mut self, bytes: &[u8]) -> Result<(), serde_json::Error> {
+        self.rng = serde_json::from_slice(bytes)?;
+        Ok(())
+    }
+
     /// Whether every particle has been inserted.
     pub fn is_done(&self) -> bool {
         self.inserted >= self.count

@@ -8,7 +8,7 @@ mod walls;
 use nalgebra::{Point3, UnitQuaternion, Vector3};
 
 pub use inlet::{Inlet, PLACEMENT_ATTEMPTS, is_free, random_orientation};
-pub use motion::{MotionKey, WallMotion, WallVelocity, advance_pose};
+pub use motion::{DriveInput, MotionKey, WallMotion, WallVelocity, advance_pose};
 pub use walls::{FacetGrid, Wall};
 
 use crate::Real;

@@ -49,7 +49,19 @@ pub enum WallMotion {
     /// Velocities interpolated linearly between keys (held constant outside).
     Table(Vec<MotionKey>),
     /// Set from outside (co-simulation inputs); the velocities stay as last set.
-    External,
+    External(DriveInput),
+}
+
+/// What a co-simulation master gives for a wall driven from outside.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum DriveInput {
+    /// Linear and angular velocity, held over each communication step.
+    #[default]
+    Velocity,
+    /// The pose to reach at the end of each communication step (reference point
+    /// position and orientation); the wall moves there at constant velocity.
+    Pose,
 }
 
 /// Linear and angular velocity of a wall at one instant.
@@ -89,7 +101,7 @@ impl WallMotion {
                 })
             }
             WallMotion::Table(keys) => Some(interpolate(keys, t)),
-            WallMotion::External => None,
+            WallMotion::External(_) => None,
         }
     }
 }

@@ -1,0 +1,306 @@
+//! Reading and writing variables: every access checked against the variable's type,
+//! causality and the mode, and a batch of writes applied all or none.
+
+use super::component::{Component, Mode, RUNNING, WallDrive, fingerprint};
+use super::variables::{Causality, Role, VarType, Variable, variable_table};
+use super::{CosimError, VarRef};
+use crate::Real;
+use crate::scene::Scene;
+
+const ANY_BUT_ERROR: &str = "instantiated, initialisation, step, terminated";
+
+impl Component {
+    fn var(&self, r: VarRef) -> Result<&Variable, CosimError> {
+        let v = self
+            .variables
+            .get(r.var)
+            .ok_or_else(|| CosimError::UnknownVariable(format!("index {}", r.var)))?;
+        if r.element >= v.size {
+            return Err(CosimError::BadAccess {
+                name: v.name.clone(),
+                problem: format!("element {} of a variable of size {}", r.element, v.size),
+            });
+        }
+        Ok(v)
+    }
+
+    fn check_type(v: &Variable, ty: VarType) -> Result<(), CosimError> {
+        if v.ty == ty {
+            Ok(())
+        } else {
+            Err(CosimError::BadAccess {
+                name: v.name.clone(),
+                problem: format!("is of type {:?}, not {ty:?}", v.ty),
+            })
+        }
+    }
+
+    fn check_readable(&self, v: &Variable) -> Result<(), CosimError> {
+        let running = [Mode::Initialisation, Mode::Step, Mode::Terminated];
+        match v.causality {
+            Causality::Output | Causality::Independent => {
+                self.expect_mode("getting an output", &running, RUNNING)
+            }
+            _ => self.expect_mode(
+                "getting a value",
+                &[
+                    Mode::Instantiated,
+                    Mode::Initialisation,
+                    Mode::Step,
+                    Mode::Terminated,
+                ],
+                ANY_BUT_ERROR,
+            ),
+        }
+    }
+
+    fn check_writable(&self, v: &Variable) -> Result<(), CosimError> {
+        match v.causality {
+            Causality::Parameter => self.expect_mode(
+                "setting a parameter",
+                &[Mode::Instantiated, Mode::Initialisation],
+                "instantiated, initialisation",
+            ),
+            Causality::Input => self.expect_mode(
+                "setting an input",
+                &[Mode::Instantiated, Mode::Initialisation, Mode::Step],
+                "instantiated, initialisation, step",
+            ),
+            _ => Err(CosimError::BadAccess {
+                name: v.name.clone(),
+                problem: format!("is {:?}, it cannot be set", v.causality).to_lowercase(),
+            }),
+        }
+    }
+
+    /// Reads real values.
+    pub fn get_real(&self, refs: &[VarRef], out: &mut [Real]) -> Result<(), CosimError> {
+        for (r, o) in refs.iter().zip(out.iter_mut()) {
+            let v = self.var(*r)?;
+            Self::check_type(v, VarType::Real)?;
+            self.check_readable(v)?;
+            *o = self.real_value(v.role, r.element);
+        }
+        Ok(())
+    }
+
+    /// All values of one real variable.
+    pub fn get_real_vector(&self, var: usize) -> Result<Vec<Real>, CosimError> {
+        let size = self.variables.get(var).map_or(1, |v| v.size);
+        let refs: Vec<VarRef> = (0..size).map(|element| VarRef { var, element }).collect();
+        let mut out = vec![0.0; size];
+        self.get_real(&refs, &mut out)?;
+        Ok(out)
+    }
+
+    fn real_value(&self, role: Role, k: usize) -> Real {
+        let drive = |w: usize| &self.drives[w];
+        let sim = self.sim.as_ref();
+        match role {
+            Role::Time => sim.map_or(0.0, |s| s.world.time),
+            Role::TimeStep => self.params.dt,
+            Role::KineticEnergy => sim.map_or(0.0, |s| s.world.kinetic_energy()),
+            Role::MaxSpeed => sim.map_or(0.0, |s| s.world.max_speed()),
+            Role::WallVelocity(w) => match drive(w) {
+                WallDrive::Velocity { linear, .. } => linear[k],
+                _ => 0.0,
+            },
+            Role::WallAngularVelocity(w) => match drive(w) {
+                WallDrive::Velocity { angular, .. } => angular[k],
+                _ => 0.0,
+            },
+            Role::WallPosition(w) => match drive(w) {
+                WallDrive::Pose { position, .. } => position[k],
+                _ => 0.0,
+            },
+            Role::WallOrientation(w) => match drive(w) {
+                WallDrive::Pose { orientation, .. } => orientation[k],
+                _ => 0.0,
+            },
+            Role::WallForce(w) => self.means[w].force[k],
+            Role::WallTorque(w) => self.means[w].torque[k],
+            Role::WallPower(w) => self.means[w].power,
+            Role::WallForceEnd(w) => sim.map_or(0.0, |s| s.world.walls[w].force[k]),
+            Role::WallTorqueEnd(w) => sim.map_or(0.0, |s| s.world.walls[w].torque[k]),
+            Role::WallVertices(w) => {
+                let wall = sim.map_or(&self.scene.world.walls[w], |s| &s.world.walls[w]);
+                (wall.pose * wall.vertices[k / 3])[k % 3]
+            }
+            Role::WallFacetForces(w) => {
+                sim.map_or(0.0, |s| s.world.walls[w].facet_force[k / 3][k % 3])
+            }
+            Role::Scene | Role::OutputDir | Role::Threads | Role::Particles | Role::Contacts => {
+                unreachable!("not a real variable")
+            }
+        }
+    }
+
+    /// Sets real values, all or none.
+    pub fn set_real(&mut self, refs: &[VarRef], values: &[Real]) -> Result<(), CosimError> {
+        for (r, x) in refs.iter().zip(values) {
+            let v = self.var(*r)?;
+            Self::check_type(v, VarType::Real)?;
+            self.check_writable(v)?;
+            if !x.is_finite() {
+                return Err(CosimError::BadValue {
+                    name: v.name.clone(),
+                    problem: format!("{x} is not finite"),
+                });
+            }
+            if v.role == Role::TimeStep && !(*x > 0.0) {
+                return Err(CosimError::BadValue {
+                    name: v.name.clone(),
+                    problem: format!("the time step must be positive, not {x}"),
+                });
+            }
+        }
+        let mut drives = self.drives.clone();
+        for (r, x) in refs.iter().zip(values) {
+            let role = self.variables[r.var].role;
+            let k = r.element;
+            match role {
+                Role::TimeStep => {
+                    self.params.dt = *x;
+                    if let Some(sim) = &mut self.sim {
+                        sim.engine.dt = *x;
+                    }
+                }
+                Role::WallVelocity(w) => {
+                    if let WallDrive::Velocity { linear, .. } = &mut drives[w] {
+                        linear[k] = *x;
+                    }
+                }
+                Role::WallAngularVelocity(w) => {
+                    if let WallDrive::Velocity { angular, .. } = &mut drives[w] {
+                        angular[k] = *x;
+                    }
+                }
+                Role::WallPosition(w) => {
+                    if let WallDrive::Pose { position, .. } = &mut drives[w] {
+                        position[k] = *x;
+                    }
+                }
+                Role::WallOrientation(w) => {
+                    if let WallDrive::Pose { orientation, .. } = &mut drives[w] {
+                        orientation[k] = *x;
+                    }
+                }
+                _ => unreachable!("checked writable above"),
+            }
+        }
+        // A quaternion is checked when it is used (a master sets its elements one by
+        // one): a zero quaternion at a step is an error there.
+        self.drives = drives;
+        Ok(())
+    }
+
+    /// Sets all values of one real variable.
+    pub fn set_real_vector(&mut self, var: usize, values: &[Real]) -> Result<(), CosimError> {
+        let refs: Vec<VarRef> = (0..values.len())
+            .map(|element| VarRef { var, element })
+            .collect();
+        self.set_real(&refs, values)
+    }
+
+    /// Reads integer values.
+    pub fn get_integer(&self, refs: &[VarRef], out: &mut [i64]) -> Result<(), CosimError> {
+        for (r, o) in refs.iter().zip(out.iter_mut()) {
+            let v = self.var(*r)?;
+            Self::check_type(v, VarType::Integer)?;
+            self.check_readable(v)?;
+            let sim = self.sim.as_ref();
+            *o = match v.role {
+                Role::Threads => self.params.threads as i64,
+                Role::Particles => sim.map_or(0, |s| s.world.particles.len() as i64),
+                Role::Contacts => sim.map_or(0, |s| s.engine.contacts as i64),
+                _ => unreachable!("not an integer variable"),
+            };
+        }
+        Ok(())
+    }
+
+    /// Sets integer values, all or none.
+    pub fn set_integer(&mut self, refs: &[VarRef], values: &[i64]) -> Result<(), CosimError> {
+        for (r, x) in refs.iter().zip(values) {
+            let v = self.var(*r)?;
+            Self::check_type(v, VarType::Integer)?;
+            self.check_writable(v)?;
+            // Threads is the only settable integer.
+            if !(1..=1024).contains(x) {
+                return Err(CosimError::BadValue {
+                    name: v.name.clone(),
+                    problem: format!("{x} threads; give 1 to 1024"),
+                });
+            }
+            if self.mode != Mode::Instantiated && *x as usize != self.params.threads {
+                return Err(CosimError::BadValue {
+                    name: v.name.clone(),
+                    problem: "the thread count is fixed once initialisation starts".into(),
+                });
+            }
+        }
+        if let Some(x) = values.iter().take(refs.len()).next_back() {
+            self.params.threads = *x as usize;
+        }
+        Ok(())
+    }
+
+    /// Reads string values.
+    pub fn get_string(&self, refs: &[VarRef]) -> Result<Vec<String>, CosimError> {
+        refs.iter()
+            .map(|r| {
+                let v = self.var(*r)?;
+                Self::check_type(v, VarType::String)?;
+                self.check_readable(v)?;
+                Ok(match v.role {
+                    Role::Scene => self.params.scene.clone(),
+                    Role::OutputDir => self.params.output_dir.clone(),
+                    _ => unreachable!("not a string variable"),
+                })
+            })
+            .collect()
+    }
+
+    /// Sets string values (the scene before initialisation, the output directory
+    /// before stepping).
+    pub fn set_string(&mut self, refs: &[VarRef], values: &[&str]) -> Result<(), CosimError> {
+        let mut scene = None;
+        let mut params = self.params.clone();
+        for (r, x) in refs.iter().zip(values) {
+            let v = self.var(*r)?;
+            Self::check_type(v, VarType::String)?;
+            self.check_writable(v)?;
+            match v.role {
+                Role::Scene if *x != params.scene => {
+                    if self.mode != Mode::Instantiated {
+                        return Err(CosimError::BadValue {
+                            name: v.name.clone(),
+                            problem: "the scene is fixed once initialisation starts".into(),
+                        });
+                    }
+                    let loaded = Scene::load(&self.base_dir.join(x))?;
+                    if variable_table(&loaded) != self.variables {
+                        return Err(CosimError::BadValue {
+                            name: v.name.clone(),
+                            problem: format!(
+                                "scene '{x}' has other variables than the one instantiated"
+                            ),
+                        });
+                    }
+                    params.scene = x.to_string();
+                    params.dt = loaded.dt;
+                    scene = Some(loaded);
+                }
+                Role::Scene => {}
+                Role::OutputDir => params.output_dir = x.to_string(),
+                _ => unreachable!("not a string variable"),
+            }
+        }
+        if let Some(scene) = scene {
+            self.fingerprint = fingerprint(&scene);
+            self.scene = scene;
+        }
+        self.params = params;
+        Ok(())
+    }
+}

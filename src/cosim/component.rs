@@ -1,0 +1,535 @@
+//! The component: life cycle and communication steps.
+
+use std::fmt;
+use std::path::{Path, PathBuf};
+
+use nalgebra::{Point3, Quaternion, UnitQuaternion, Vector3};
+
+use super::CosimError;
+use super::pool::JoinedPool;
+use super::variables::{Variable, variable_table};
+use crate::Real;
+use crate::output::RunOutput;
+use crate::scene::{Scene, Simulation};
+use crate::world::{DriveInput, WallMotion};
+
+/// Mode of the life cycle.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Mode {
+    /// Created; parameters and start values may be set.
+    Instantiated,
+    /// Between enter and exit of initialisation: the simulation exists, outputs can be
+    /// read, inputs and parameters set.
+    Initialisation,
+    /// Stepping.
+    Step,
+    /// Terminated: outputs can still be read.
+    Terminated,
+    /// A panic or an unrecoverable failure: only reset or free.
+    Error,
+}
+
+impl fmt::Display for Mode {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Mode::Instantiated => "instantiated",
+            Mode::Initialisation => "initialisation",
+            Mode::Step => "step",
+            Mode::Terminated => "terminated",
+            Mode::Error => "error",
+        })
+    }
+}
+
+/// One element of a variable: `(variable index, element index)`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct VarRef {
+    /// Index into [`Component::variables`].
+    pub var: usize,
+    /// Element within the variable (0 for a scalar).
+    pub element: usize,
+}
+
+/// What the master set for one wall driven from outside (held over a step).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum WallDrive {
+    /// Not driven from outside.
+    Prescribed,
+    /// Linear and angular velocity.
+    Velocity {
+        /// Of the reference point.
+        linear: Vector3<Real>,
+        /// About the reference point.
+        angular: Vector3<Real>,
+    },
+    /// Pose to reach at the end of the step; the quaternion (w, x, y, z) as set,
+    /// normalised when used.
+    Pose {
+        /// Reference point.
+        position: Vector3<Real>,
+        /// Orientation as given.
+        orientation: [Real; 4],
+    },
+}
+
+/// Mean force, torque and power on one wall over the last communication step.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct WallMeans {
+    /// Mean force, N.
+    pub force: Vector3<Real>,
+    /// Mean torque about the reference point, N m.
+    pub torque: Vector3<Real>,
+    /// Mean power delivered to the particles, W.
+    pub power: Real,
+}
+
+/// A saved state: everything that evolves, in memory.
+#[derive(Clone, Debug)]
+pub struct ComponentState {
+    pub(super) mode: Mode,
+    pub(super) sim: Simulation,
+    pub(super) drives: Vec<WallDrive>,
+    pub(super) means: Vec<WallMeans>,
+}
+
+/// A wall's mesh as it is placed now.
+#[derive(Clone, Debug)]
+pub struct WallMesh<'a> {
+    /// Vertices in the world.
+    pub vertices: Vec<Point3<Real>>,
+    /// Triangles (vertex indices), counter-clockwise seen from the particles.
+    pub triangles: &'a [[u32; 3]],
+}
+
+/// Parameters a master may change before the simulation runs.
+#[derive(Clone, Debug, PartialEq)]
+pub(super) struct Parameters {
+    pub(super) scene: String,
+    pub(super) dt: Real,
+    pub(super) output_dir: String,
+    pub(super) threads: usize,
+}
+
+/// A scene behind an FMI-style life cycle (see the [module docs](super)).
+pub struct Component {
+    pub(super) base_dir: PathBuf,
+    pub(super) scene: Scene,
+    pub(super) fingerprint: u64,
+    pub(super) variables: Vec<Variable>,
+    pub(super) mode: Mode,
+    pub(super) start: Parameters,
+    pub(super) params: Parameters,
+    pub(super) drives: Vec<WallDrive>,
+    pub(super) means: Vec<WallMeans>,
+    pub(super) sim: Option<Simulation>,
+    pub(super) pool: Option<JoinedPool>,
+    pub(super) output: Option<RunOutput>,
+}
+
+impl fmt::Debug for Component {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("Component")
+            .field("scene", &self.scene.file)
+            .field("mode", &self.mode)
+            .field("time", &self.sim.as_ref().map(|s| s.world.time))
+            .finish()
+    }
+}
+
+/// A 64-bit fingerprint of a scene: its whole specification and variable names. A
+/// saved state carries it; an FMU's guid is made from it.
+pub fn fingerprint(scene: &Scene) -> u64 {
+    let mut text = format!("talus {} {:?}", env!("CARGO_PKG_VERSION"), scene.spec);
+    for v in variable_table(scene) {
+        text.push_str(&v.name);
+    }
+    fnv1a(text.as_bytes(), 0xcbf2_9ce4_8422_2325)
+}
+
+fn fnv1a(bytes: &[u8], seed: u64) -> u64 {
+    bytes
+        .iter()
+        .fold(seed, |h, b| (h ^ *b as u64).wrapping_mul(0x0100_0000_01b3))
+}
+
+pub(super) const RUNNING: &str = "initialisation, step, terminated";
+
+impl Component {
+    /// Loads the scene at `path` (relative to `base_dir` when relative).
+    pub fn instantiate(base_dir: &Path, path: &str) -> Result<Self, CosimError> {
+        let scene = Scene::load(&base_dir.join(path))?;
+        let start = Parameters {
+            scene: path.to_string(),
+            dt: scene.dt,
+            output_dir: String::new(),
+            threads: scene.spec.simulation.threads.max(1),
+        };
+        let drives = initial_drives(&scene);
+        Ok(Component {
+            base_dir: base_dir.to_path_buf(),
+            fingerprint: fingerprint(&scene),
+            variables: variable_table(&scene),
+            mode: Mode::Instantiated,
+            params: start.clone(),
+            start,
+            means: vec![WallMeans::default(); drives.len()],
+            drives,
+            scene,
+            sim: None,
+            pool: None,
+            output: None,
+        })
+    }
+
+    /// The variable table.
+    pub fn variables(&self) -> &[Variable] {
+        &self.variables
+    }
+
+    /// Index of the variable called `name`.
+    pub fn variable(&self, name: &str) -> Result<usize, CosimError> {
+        self.variables
+            .iter()
+            .position(|v| v.name == name)
+            .ok_or_else(|| CosimError::UnknownVariable(format!("'{name}'")))
+    }
+
+    /// The scene's fingerprint (see [`fingerprint`]).
+    pub fn fingerprint(&self) -> u64 {
+        self.fingerprint
+    }
+
+    /// The loaded scene.
+    pub fn scene(&self) -> &Scene {
+        &self.scene
+    }
+
+    /// The current mode.
+    pub fn mode(&self) -> Mode {
+        self.mode
+    }
+
+    /// The running simulation (from initialisation on).
+    pub fn simulation(&self) -> Option<&Simulation> {
+        self.sim.as_ref()
+    }
+
+    /// Puts the component in the error state (after a panic in a call).
+    pub fn fail(&mut self) {
+        self.mode = Mode::Error;
+    }
+
+    pub(super) fn expect_mode(
+        &self,
+        call: &'static str,
+        allowed: &[Mode],
+        names: &'static str,
+    ) -> Result<(), CosimError> {
+        if allowed.contains(&self.mode) {
+            Ok(())
+        } else {
+            Err(CosimError::WrongMode {
+                call,
+                mode: self.mode,
+                allowed: names,
+            })
+        }
+    }
+
+    /// Leaves instantiation: builds the simulation from the parameters, starting at
+    /// `start_time`.
+    pub fn enter_initialization_mode(&mut self, start_time: Real) -> Result<(), CosimError> {
+        self.expect_mode(
+            "enter_initialization_mode",
+            &[Mode::Instantiated],
+            "instantiated",
+        )?;
+        if !start_time.is_finite() {
+            return Err(CosimError::BadStep(format!(
+                "start time {start_time} is not finite"
+            )));
+        }
+        let pool =
+            JoinedPool::new(self.params.threads).map_err(|e| CosimError::Threads(e.to_string()))?;
+        let mut sim = pool.install(|| Simulation::new(&self.scene));
+        sim.engine.dt = self.params.dt;
+        sim.world.time = start_time;
+        self.pool = Some(pool);
+        self.sim = Some(sim);
+        self.means = vec![WallMeans::default(); self.drives.len()];
+        self.mode = Mode::Initialisation;
+        Ok(())
+    }
+
+    /// Starts stepping: applies the inputs and evaluates the forces at the start time.
+    pub fn exit_initialization_mode(&mut self) -> Result<(), CosimError> {
+        self.expect_mode(
+            "exit_initialization_mode",
+            &[Mode::Initialisation],
+            "initialisation",
+        )?;
+        let output = if self.params.output_dir.is_empty() {
+            None
+        } else {
+            let sim = self.sim.as_ref().expect("initialisation has a simulation");
+            let out = &self.scene.spec.output;
+            Some(RunOutput::create(
+                &self.base_dir.join(&self.params.output_dir),
+                &sim.world,
+                out.frame_interval,
+                out.csv_interval,
+            )?)
+        };
+        self.check_orientations()?;
+        let sim = self
+            .sim
+            .as_mut()
+            .expect("a running component has a simulation");
+        let pool = self.pool.as_ref().expect("a running component has a pool");
+        for (w, drive) in self.drives.iter().enumerate() {
+            let wall = &mut sim.world.walls[w];
+            match drive {
+                WallDrive::Prescribed => {}
+                WallDrive::Velocity { linear, angular } => {
+                    wall.velocity = *linear;
+                    wall.angular_velocity = *angular;
+                }
+                WallDrive::Pose {
+                    position,
+                    orientation,
+                } => {
+                    wall.pose.translation.vector = *position;
+                    wall.pose.rotation = unit_quaternion(orientation);
+                }
+            }
+        }
+        pool.install(|| sim.engine.initialise(&mut sim.world));
+        self.means = instantaneous_means(sim);
+        self.output = output;
+        self.mode = Mode::Step;
+        Ok(())
+    }
+
+    fn check_orientations(&self) -> Result<(), CosimError> {
+        for (w, drive) in self.drives.iter().enumerate() {
+            if let WallDrive::Pose { orientation, .. } = drive {
+                let norm = orientation.iter().map(|x| x * x).sum::<Real>().sqrt();
+                if !(norm > 1e-12) {
+                    return Err(CosimError::BadValue {
+                        name: format!("{}.orientation", self.scene.world.walls[w].name),
+                        problem: "the quaternion is zero".into(),
+                    });
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Advances from `t` (the current time) by `h`, inputs held.
+    pub fn do_step(&mut self, t: Real, h: Real) -> Result<(), CosimError> {
+        self.expect_mode("do_step", &[Mode::Step], "step")?;
+        if !(h > 0.0) || !h.is_finite() {
+            return Err(CosimError::BadStep(format!(
+                "step size {h} must be positive and finite"
+            )));
+        }
+        let now = self.sim.as_ref().expect("step mode").world.time;
+        if !t.is_finite() || (t - now).abs() > 1e-9 * now.abs().max(h) {
+            return Err(CosimError::BadStep(format!(
+                "the step starts at {t} but the component is at time {now}"
+            )));
+        }
+        let drives = self.drives.clone();
+        self.check_orientations()?;
+        let sim = self
+            .sim
+            .as_mut()
+            .expect("a running component has a simulation");
+        let pool = self.pool.as_ref().expect("a running component has a pool");
+        let before = sim.clone();
+        let end = t + h;
+        let dt = sim.engine.dt;
+        let walls = sim.world.walls.len();
+        let mut impulse = vec![WallMeans::default(); walls];
+        let mut targets = Vec::new();
+        for (w, drive) in drives.iter().enumerate() {
+            let wall = &mut sim.world.walls[w];
+            match drive {
+                WallDrive::Prescribed => {}
+                WallDrive::Velocity { linear, angular } => {
+                    wall.velocity = *linear;
+                    wall.angular_velocity = *angular;
+                }
+                WallDrive::Pose {
+                    position,
+                    orientation,
+                } => {
+                    let q = unit_quaternion(orientation);
+                    wall.velocity = (position - wall.pose.translation.vector) / h;
+                    wall.angular_velocity = (q * wall.pose.rotation.inverse()).scaled_axis() / h;
+                    targets.push((w, *position, q));
+                }
+            }
+        }
+        let mut output = self.output.take();
+        let result = pool.install(|| -> std::io::Result<()> {
+            let mut last = instantaneous_means(sim);
+            while sim.world.time < end {
+                let left = end - sim.world.time;
+                let sub = if left <= dt * (1.0 + 1e-6) { left } else { dt };
+                sim.engine.dt = sub;
+                sim.step();
+                let now = instantaneous_means(sim);
+                for ((acc, a), b) in impulse.iter_mut().zip(&last).zip(&now) {
+                    acc.force += (a.force + b.force) * (0.5 * sub);
+                    acc.torque += (a.torque + b.torque) * (0.5 * sub);
+                    acc.power += (a.power + b.power) * (0.5 * sub);
+                }
+                last = now;
+                if let Some(out) = &mut output {
+                    out.record(&sim.world, sub, sim.engine.contacts, false)?;
+                }
+                if sub == left {
+                    break;
+                }
+            }
+            Ok(())
+        });
+        sim.engine.dt = dt;
+        sim.world.time = end;
+        for (w, position, q) in targets {
+            let wall = &mut sim.world.walls[w];
+            wall.pose.translation.vector = position;
+            wall.pose.rotation = q;
+        }
+        self.output = output;
+        if let Some(problem) = divergence(sim) {
+            *sim = before;
+            return Err(CosimError::Diverged(problem));
+        }
+        result?;
+        self.means = impulse
+            .iter()
+            .map(|m| WallMeans {
+                force: m.force / h,
+                torque: m.torque / h,
+                power: m.power / h,
+            })
+            .collect();
+        Ok(())
+    }
+
+    /// Ends the run (writes the last output rows and frame).
+    pub fn terminate(&mut self) -> Result<(), CosimError> {
+        self.expect_mode(
+            "terminate",
+            &[Mode::Initialisation, Mode::Step],
+            "initialisation, step",
+        )?;
+        if let (Some(out), Some(sim)) = (&mut self.output, &self.sim) {
+            out.record(&sim.world, sim.engine.dt, sim.engine.contacts, true)?;
+        }
+        self.output = None;
+        self.mode = Mode::Terminated;
+        Ok(())
+    }
+
+    /// Back to the instantiated mode with the start values (any mode).
+    pub fn reset(&mut self) {
+        self.sim = None;
+        self.pool = None;
+        self.output = None;
+        if self.params.scene != self.start.scene {
+            if let Ok(scene) = Scene::load(&self.base_dir.join(&self.start.scene)) {
+                self.fingerprint = fingerprint(&scene);
+                self.scene = scene;
+            }
+        }
+        self.params = self.start.clone();
+        self.drives = initial_drives(&self.scene);
+        self.means = vec![WallMeans::default(); self.drives.len()];
+        self.mode = Mode::Instantiated;
+    }
+
+    /// Wall `w`'s vertices in the world and its triangles.
+    pub fn wall_mesh(&self, w: usize) -> Option<WallMesh<'_>> {
+        let wall = self
+            .sim
+            .as_ref()
+            .map_or(self.scene.world.walls.get(w), |s| s.world.walls.get(w))?;
+        Some(WallMesh {
+            vertices: wall.vertices.iter().map(|v| wall.pose * v).collect(),
+            triangles: &wall.triangles,
+        })
+    }
+
+    /// Index of the wall called `name`.
+    pub fn wall(&self, name: &str) -> Option<usize> {
+        self.scene.world.walls.iter().position(|w| w.name == name)
+    }
+
+    /// Mean force, torque and power on each wall over the last step.
+    pub fn wall_means(&self) -> &[WallMeans] {
+        &self.means
+    }
+}
+
+fn initial_drives(scene: &Scene) -> Vec<WallDrive> {
+    scene
+        .world
+        .walls
+        .iter()
+        .map(|wall| match wall.motion {
+            WallMotion::External(DriveInput::Velocity) => WallDrive::Velocity {
+                linear: wall.velocity,
+                angular: wall.angular_velocity,
+            },
+            WallMotion::External(DriveInput::Pose) => {
+                let q = wall.pose.rotation;
+                WallDrive::Pose {
+                    position: wall.pose.translation.vector,
+                    orientation: [q.w, q.i, q.j, q.k],
+                }
+            }
+            _ => WallDrive::Prescribed,
+        })
+        .collect()
+}
+
+fn unit_quaternion(q: &[Real; 4]) -> UnitQuaternion<Real> {
+    let q = Quaternion::new(q[0], q[1], q[2], q[3]);
+    if q.norm() > 0.0 {
+        UnitQuaternion::from_quaternion(q)
+    } else {
+        UnitQuaternion::identity()
+    }
+}
+
+fn instantaneous_means(sim: &Simulation) -> Vec<WallMeans> {
+    sim.world
+        .walls
+        .iter()
+        .map(|w| WallMeans {
+            force: w.force,
+            torque: w.torque,
+            power: w.power(),
+        })
+        .collect()
+}
+
+/// What is not finite in the state, if anything.
+fn divergence(sim: &Simulation) -> Option<String> {
+    let p = &sim.world.particles;
+    for i in 0..p.len() {
+        if !(p.position[i].coords.iter().all(|x| x.is_finite())
+            && p.velocity[i].iter().all(|x| x.is_finite())
+            && p.angular_momentum[i].iter().all(|x| x.is_finite()))
+        {
+            return Some(format!(
+                "particle {} has a non-finite position or velocity",
+                p.id[i]
+            ));
+        }
+    }
+    None
+}

@@ -1,0 +1,126 @@
+//! Saved states: in memory for a rollback, and as bytes (FMI serialised states, the
+//! zenoh `state` queryable). The bytes are the simulation's state (see
+//! [`crate::scene::state`]) followed by the component's inputs, outputs and mode.
+
+use super::CosimError;
+use super::component::{Component, ComponentState, Mode, RUNNING, WallDrive, WallMeans};
+use crate::scene::{StateError, StateReader, StateWriter};
+
+impl Component {
+    /// The state as it is now (initialisation, step or terminated mode).
+    pub fn save_state(&self) -> Result<ComponentState, CosimError> {
+        self.expect_mode(
+            "saving the state",
+            &[Mode::Initialisation, Mode::Step, Mode::Terminated],
+            RUNNING,
+        )?;
+        Ok(ComponentState {
+            mode: self.mode,
+            sim: self.sim.clone().expect("running"),
+            drives: self.drives.clone(),
+            means: self.means.clone(),
+        })
+    }
+
+    /// Goes back to a saved state (of this scene).
+    pub fn restore_state(&mut self, state: &ComponentState) -> Result<(), CosimError> {
+        self.expect_mode(
+            "restoring a state",
+            &[Mode::Initialisation, Mode::Step, Mode::Terminated],
+            RUNNING,
+        )?;
+        if state.drives.len() != self.drives.len() {
+            return Err(CosimError::State(StateError::Corrupt(
+                "a state of another scene".into(),
+            )));
+        }
+        self.mode = state.mode;
+        self.sim = Some(state.sim.clone());
+        self.drives = state.drives.clone();
+        self.means = state.means.clone();
+        Ok(())
+    }
+
+    /// A saved state as bytes.
+    pub fn state_to_bytes(&self, state: &ComponentState) -> Vec<u8> {
+        let mut w = StateWriter::default();
+        state.sim.write_state(self.fingerprint, &mut w);
+        w.u64(match state.mode {
+            Mode::Initialisation => 1,
+            Mode::Step => 2,
+            _ => 3,
+        });
+        for (d, m) in state.drives.iter().zip(&state.means) {
+            match d {
+                WallDrive::Prescribed => w.u64(0),
+                WallDrive::Velocity { linear, angular } => {
+                    w.u64(1);
+                    w.vec3(linear);
+                    w.vec3(angular);
+                }
+                WallDrive::Pose {
+                    position,
+                    orientation,
+                } => {
+                    w.u64(2);
+                    w.vec3(position);
+                    orientation.iter().for_each(|x| w.f64(*x));
+                }
+            }
+            w.vec3(&m.force);
+            w.vec3(&m.torque);
+            w.f64(m.power);
+        }
+        w.into_bytes()
+    }
+
+    /// A state from bytes written by [`Component::state_to_bytes`] for this scene.
+    /// Needs the simulation (initialisation mode or later).
+    pub fn state_from_bytes(&self, bytes: &[u8]) -> Result<ComponentState, CosimError> {
+        self.expect_mode(
+            "reading a state",
+            &[Mode::Initialisation, Mode::Step, Mode::Terminated],
+            RUNNING,
+        )?;
+        let mut sim = self.sim.clone().expect("running");
+        let mut r = StateReader::new(bytes);
+        sim.read_state(self.fingerprint, &mut r)?;
+        let corrupt = |m: &str| CosimError::State(StateError::Corrupt(m.into()));
+        let mode = match r.u64()? {
+            1 => Mode::Initialisation,
+            2 => Mode::Step,
+            3 => Mode::Terminated,
+            _ => return Err(corrupt("unknown mode")),
+        };
+        let mut drives = Vec::new();
+        let mut means = Vec::new();
+        for _ in 0..self.drives.len() {
+            drives.push(match r.u64()? {
+                0 => WallDrive::Prescribed,
+                1 => WallDrive::Velocity {
+                    linear: r.vec3()?,
+                    angular: r.vec3()?,
+                },
+                2 => WallDrive::Pose {
+                    position: r.vec3()?,
+                    orientation: [r.f64()?, r.f64()?, r.f64()?, r.f64()?],
+                },
+                _ => return Err(corrupt("unknown wall drive")),
+            });
+            means.push(WallMeans {
+                force: r.vec3()?,
+                torque: r.vec3()?,
+                power: r.f64()?,
+            });
+        }
+        if !r.is_done() {
+            return Err(corrupt("trailing bytes after the state"));
+        }
+        Ok(ComponentState {
+            mode,
+            sim,
+            drives,
+            means,
+        })
+    }
+}

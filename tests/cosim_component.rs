@@ -1,0 +1,348 @@
+//! The co-simulation component: life cycle, misuse, communication steps, momentum
+//! handed across the interface, torque response, and saved states.
+
+use std::path::Path;
+
+use nalgebra::Vector3;
+use talus::cosim::{Component, CosimError, Mode, VarRef};
+
+fn drum(file: &str) -> Component {
+    Component::instantiate(
+        Path::new(env!("CARGO_MANIFEST_DIR")),
+        &format!("examples/drum_fmu/{file}"),
+    )
+    .unwrap()
+}
+
+fn started(file: &str) -> Component {
+    let mut c = drum(file);
+    c.enter_initialization_mode(0.0).unwrap();
+    c.exit_initialization_mode().unwrap();
+    c
+}
+
+fn set_spin(c: &mut Component, omega_y: f64) {
+    let w = c.variable("drum.angular_velocity").unwrap();
+    c.set_real_vector(w, &[0.0, omega_y, 0.0]).unwrap();
+}
+
+fn vector(c: &Component, name: &str) -> Vec<f64> {
+    c.get_real_vector(c.variable(name).unwrap()).unwrap()
+}
+
+fn time(c: &Component) -> f64 {
+    vector(c, "time")[0]
+}
+
+#[test]
+fn the_variable_table_names_inputs_outputs_and_units() {
+    let c = drum("drum.toml");
+    let names: Vec<&str> = c.variables().iter().map(|v| v.name.as_str()).collect();
+    for n in [
+        "time",
+        "scene",
+        "dt",
+        "output_dir",
+        "threads",
+        "drum.velocity",
+        "drum.angular_velocity",
+        "drum.force",
+        "drum.torque",
+        "drum.force_end",
+        "drum.torque_end",
+        "drum.power",
+        "drum.vertices",
+        "drum.facet_force",
+        "particles",
+        "contacts",
+        "kinetic_energy",
+    ] {
+        assert!(names.contains(&n), "{n} missing from {names:?}");
+    }
+    let torque = &c.variables()[c.variable("drum.torque").unwrap()];
+    assert_eq!(torque.unit, Some("N.m"));
+    assert_eq!(torque.size, 3);
+    assert!(!torque.description.is_empty());
+}
+
+#[test]
+fn calls_out_of_order_are_refused_and_change_nothing() {
+    let mut c = drum("drum.toml");
+    let err = c.do_step(0.0, 1e-3).unwrap_err();
+    assert!(matches!(err, CosimError::WrongMode { .. }), "{err}");
+    assert!(err.to_string().contains("instantiated"), "{err}");
+    let force = c.variable("drum.force").unwrap();
+    assert!(matches!(
+        c.get_real_vector(force),
+        Err(CosimError::WrongMode { .. })
+    ));
+    assert!(matches!(
+        c.exit_initialization_mode(),
+        Err(CosimError::WrongMode { .. })
+    ));
+    assert_eq!(c.mode(), Mode::Instantiated);
+
+    // Inputs: non-finite values are refused, the old value stays.
+    let w = c.variable("drum.angular_velocity").unwrap();
+    c.set_real_vector(w, &[0.0, 2.0, 0.0]).unwrap();
+    for bad in [f64::NAN, f64::INFINITY] {
+        assert!(matches!(
+            c.set_real_vector(w, &[0.0, bad, 0.0]),
+            Err(CosimError::BadValue { .. })
+        ));
+    }
+    assert_eq!(c.get_real_vector(w).unwrap(), vec![0.0, 2.0, 0.0]);
+    // Outputs cannot be set, unknown variables are named.
+    assert!(c.set_real_vector(force, &[1.0, 2.0, 3.0]).is_err());
+    assert!(matches!(
+        c.variable("nope"),
+        Err(CosimError::UnknownVariable(_))
+    ));
+    let out_of_range = VarRef { var: w, element: 3 };
+    assert!(c.set_real(&[out_of_range], &[1.0]).is_err());
+    assert!(
+        c.set_real(
+            &[VarRef {
+                var: 10_000,
+                element: 0
+            }],
+            &[1.0]
+        )
+        .is_err()
+    );
+    // A non-positive time step is refused.
+    let dt = c.variable("dt").unwrap();
+    assert!(c.set_real_vector(dt, &[0.0]).is_err());
+    assert!(c.set_real_vector(dt, &[-1e-5]).is_err());
+
+    c.enter_initialization_mode(0.0).unwrap();
+    c.exit_initialization_mode().unwrap();
+    for (t, h) in [
+        (0.0, 0.0),
+        (0.0, -1e-3),
+        (0.0, f64::NAN),
+        (0.0, f64::INFINITY),
+        (0.5, 1e-3),
+        (f64::NAN, 1e-3),
+    ] {
+        let err = c.do_step(t, h).unwrap_err();
+        assert!(matches!(err, CosimError::BadStep(_)), "({t}, {h}): {err}");
+    }
+    assert_eq!(time(&c), 0.0);
+    assert_eq!(c.mode(), Mode::Step);
+    // Parameters are fixed once running.
+    assert!(c.set_real_vector(dt, &[1e-5]).is_err());
+    c.terminate().unwrap();
+    assert!(c.do_step(0.0, 1e-3).is_err());
+    c.reset();
+    assert_eq!(c.mode(), Mode::Instantiated);
+    assert_eq!(
+        c.get_real_vector(w).unwrap(),
+        vec![0.0, 0.0, 0.0],
+        "reset restores start values"
+    );
+}
+
+/// Communication steps land exactly on t + h, however h relates to dt.
+#[test]
+fn steps_land_on_the_communication_points() {
+    let mut c = started("drum.toml");
+    let dt = vector(&c, "dt")[0];
+    let mut t = 0.0;
+    for h in [0.37 * dt, 2.5 * dt, 1e-3, dt] {
+        c.do_step(t, h).unwrap();
+        t += h;
+        assert_eq!(time(&c), t);
+    }
+    let sim = c.simulation().unwrap();
+    // 1 + 3 + ceil(1e-3/dt) + 1 DEM steps.
+    assert_eq!(sim.steps, 1 + 3 + (1e-3 / dt).ceil() as u64 + 1);
+    assert_eq!(
+        sim.engine.dt, dt,
+        "the shortened last step does not change dt"
+    );
+}
+
+/// The mean wall force over a step is the momentum the particles exchanged with the
+/// wall: Σ m Δv = M g h + F̄ h, to round-off.
+#[test]
+fn mean_wall_force_is_the_impulse_the_particles_received() {
+    let mut c = started("drum.toml");
+    set_spin(&mut c, 3.0);
+    let momentum = |c: &Component| -> (Vector3<f64>, f64) {
+        let w = &c.simulation().unwrap().world;
+        let p = &w.particles;
+        (0..p.len()).fold((Vector3::zeros(), 0.0), |(sum, m), i| {
+            let mass = w.body_types[p.body_type[i] as usize].mass;
+            (sum + p.velocity[i] * mass, m + mass)
+        })
+    };
+    let mut t = 0.0;
+    for h in [0.05, 0.013, 0.1] {
+        let (before, mass) = momentum(&c);
+        c.do_step(t, h).unwrap();
+        t += h;
+        let (after, _) = momentum(&c);
+        let f = Vector3::from_column_slice(&vector(&c, "drum.force"));
+        let gravity = Vector3::new(0.0, 0.0, -9.81) * mass;
+        // The wall pushes the particles with -F (F is the force on the wall).
+        let residual = (after - before) - (gravity - f) * h;
+        let scale = mass * 9.81 * h;
+        assert!(
+            residual.norm() < 1e-9 * scale,
+            "h = {h}: residual {residual:?} of {scale}"
+        );
+    }
+    // Mean and end-of-step values are different things in a moving bed.
+    assert_ne!(vector(&c, "drum.force"), vector(&c, "drum.force_end"));
+}
+
+/// The bed lifted by the turning drum pulls back: the torque on the drum opposes the
+/// rotation, and turns sign with it; an empty drum feels nothing.
+#[test]
+fn drum_torque_follows_the_rotation() {
+    let mut empty = started("empty_drum.toml");
+    set_spin(&mut empty, 3.0);
+    empty.do_step(0.0, 0.05).unwrap();
+    assert_eq!(vector(&empty, "drum.torque"), vec![0.0; 3]);
+    assert_eq!(vector(&empty, "drum.force"), vec![0.0; 3]);
+
+    let mut c = started("drum.toml");
+    // Settle, then turn one way and the other.
+    c.do_step(0.0, 0.3).unwrap();
+    let mut t = 0.3;
+    let torque = |c: &mut Component, omega: f64, t: &mut f64| {
+        set_spin(c, omega);
+        let mut sum = 0.0;
+        for _ in 0..10 {
+            c.do_step(*t, 0.05).unwrap();
+            *t += 0.05;
+            sum += vector(c, "drum.torque")[1];
+        }
+        sum / 10.0
+    };
+    let forward = torque(&mut c, 3.0, &mut t);
+    let backward = torque(&mut c, -3.0, &mut t);
+    // Order of magnitude: the bed's weight (0.64 N) times an offset of a few cm.
+    let weight = 96.0 * 6.7021e-4 * 9.81;
+    assert!(forward < -0.05 * weight * 0.06, "forward torque {forward}");
+    assert!(
+        backward > 0.05 * weight * 0.06,
+        "backward torque {backward}"
+    );
+    assert!(forward.abs() < weight * 0.06 && backward.abs() < weight * 0.06);
+    // The drive delivers power to the bed.
+    assert!(vector(&c, "drum.power")[0] > 0.0);
+}
+
+fn outputs(c: &Component) -> Vec<f64> {
+    [
+        "drum.force",
+        "drum.torque",
+        "drum.force_end",
+        "drum.torque_end",
+        "kinetic_energy",
+        "time",
+    ]
+    .iter()
+    .flat_map(|n| vector(c, n))
+    .collect()
+}
+
+fn bits(x: &[f64]) -> Vec<u64> {
+    x.iter().map(|v| v.to_bits()).collect()
+}
+
+#[test]
+fn restoring_a_state_and_stepping_again_gives_the_same_bits() {
+    let mut c = started("drum.toml");
+    set_spin(&mut c, 3.0);
+    c.do_step(0.0, 0.1).unwrap();
+    let saved = c.save_state().unwrap();
+    let bytes = c.state_to_bytes(&saved);
+    c.do_step(0.1, 0.05).unwrap();
+    let first = outputs(&c);
+    c.restore_state(&saved).unwrap();
+    assert_eq!(time(&c), 0.1);
+    c.do_step(0.1, 0.05).unwrap();
+    assert_eq!(bits(&outputs(&c)), bits(&first), "in-memory rollback");
+
+    // Through bytes into a fresh instance.
+    let mut fresh = started("drum.toml");
+    let state = fresh.state_from_bytes(&bytes).unwrap();
+    fresh.restore_state(&state).unwrap();
+    assert_eq!(time(&fresh), 0.1);
+    fresh.do_step(0.1, 0.05).unwrap();
+    assert_eq!(bits(&outputs(&fresh)), bits(&first), "through bytes");
+
+    // Garbage, truncated bytes and a state of another scene are refused; nothing changes.
+    let before = outputs(&fresh);
+    for bad in [&b"garbage"[..], &bytes[..bytes.len() / 2], &[]] {
+        assert!(matches!(
+            fresh.state_from_bytes(bad),
+            Err(CosimError::State(_))
+        ));
+    }
+    let mut flipped = bytes.clone();
+    flipped[9] ^= 0xff; // the scene fingerprint
+    assert!(fresh.state_from_bytes(&flipped).is_err());
+    let empty = started("empty_drum.toml");
+    assert!(empty.state_from_bytes(&bytes).is_err());
+    assert_eq!(bits(&outputs(&fresh)), bits(&before));
+}
+
+#[test]
+fn a_pose_driven_wall_reaches_each_pose_and_reports_its_mesh() {
+    let dir = tempdir("pose");
+    let text = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/drum_fmu/drum.toml"),
+    )
+    .unwrap()
+    .replace("input = \"velocity\"", "input = \"pose\"");
+    std::fs::write(dir.join("drum.toml"), text).unwrap();
+    let mut c = Component::instantiate(&dir, "drum.toml").unwrap();
+    let orientation = c.variable("drum.orientation").unwrap();
+    assert_eq!(
+        c.get_real_vector(orientation).unwrap(),
+        vec![1.0, 0.0, 0.0, 0.0]
+    );
+    c.enter_initialization_mode(0.0).unwrap();
+    c.exit_initialization_mode().unwrap();
+    let start = c.wall_mesh(0).unwrap().vertices;
+    // Half a turn about y in 4 steps, a quarter of a turn per step.
+    let mut t = 0.0;
+    for k in 1..=2 {
+        let angle = 0.5 * std::f64::consts::FRAC_PI_2 * k as f64;
+        c.set_real_vector(
+            orientation,
+            &[(angle / 2.0).cos(), 0.0, (angle / 2.0).sin(), 0.0],
+        )
+        .unwrap();
+        c.do_step(t, 0.02).unwrap();
+        t += 0.02;
+        let now = c.wall_mesh(0).unwrap().vertices;
+        let q = nalgebra::UnitQuaternion::from_scaled_axis(Vector3::y() * angle);
+        let reference = nalgebra::Point3::new(0.0, 0.015, 0.0);
+        for (a, b) in start.iter().zip(&now) {
+            let expected = reference + q * (a - reference);
+            assert!((expected - b).norm() < 1e-12, "{expected} vs {b}");
+        }
+    }
+    let vertices = vector(&c, "drum.vertices");
+    let mesh = c.wall_mesh(0).unwrap();
+    let (now, triangles) = (mesh.vertices, mesh.triangles);
+    assert_eq!(vertices.len(), 3 * now.len());
+    assert_eq!(vertices[3..6], [now[1].x, now[1].y, now[1].z]);
+    assert_eq!(vector(&c, "drum.facet_force").len(), 3 * triangles.len());
+    c.set_real_vector(orientation, &[0.0; 4]).unwrap();
+    assert!(matches!(
+        c.do_step(t, 0.02),
+        Err(CosimError::BadValue { .. })
+    ));
+}
+
+fn tempdir(name: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("talus-cosim-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
