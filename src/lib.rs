@@ -16,7 +16,8 @@
 //!   field, built into a world and run as a [`scene::Simulation`].
 //! - [`cosim`]: the co-simulation [`cosim::Component`] (FMI-style life cycle,
 //!   variable table, communication steps, saved states).
-//! - [`ffi`], [`fmi2`], [`fmi3`]: the C ABI over the component.
+//! - [`ffi`], [`fmi`]: the C ABI over the component (native C API; FMI 2.0 and 3.0
+//!   Co-Simulation entry points and FMU packaging).
 //! - [`output`]: ParaView series, CSV time series, run summary.
 
 // `!(x > 0.0)` is how talus rejects NaN along with non-positive values; clippy's
@@ -26,6 +27,7 @@
 pub mod contact;
 pub mod cosim;
 pub mod engine;
+pub mod ffi;
 pub mod geometry;
 pub mod output;
 pub mod scene;

@@ -1,0 +1,513 @@
+//! The native C API (`interfaces/c/talus.h`): a scene as a component, stepped from C.
+//!
+//! Every function returns `TALUS_OK` (0) or `TALUS_ERROR` (1); the message of the last
+//! error on the calling thread is `talus_last_error()`. A refused call leaves the
+//! component as it was; a panic inside talus is caught, reported, and leaves the
+//! component in the error state (only `talus_free` is then useful). The FMI entry
+//! points live in [`crate::fmi`]; both go through [`guard`].
+
+pub mod guard;
+
+use std::cell::RefCell;
+use std::ffi::{CString, c_char, c_int};
+use std::path::Path;
+
+use guard::{catch, put, slice, slice_mut, text};
+
+use crate::cosim::Component;
+
+/// Success.
+pub const TALUS_OK: c_int = 0;
+/// Failure: see `talus_last_error`.
+pub const TALUS_ERROR: c_int = 1;
+
+thread_local! {
+    static LAST_ERROR: RefCell<CString> = RefCell::new(CString::default());
+}
+
+fn set_error(message: &str) {
+    let c = CString::new(message.replace('\0', " ")).unwrap_or_default();
+    LAST_ERROR.with(|e| *e.borrow_mut() = c);
+}
+
+/// An opaque component handle for C.
+pub struct TalusComponent {
+    component: Component,
+    saved: Vec<u8>,
+}
+
+/// Runs `f` on the handle: null checked, panics caught (the component then goes to
+/// the error state), errors stored for `talus_last_error`.
+fn with(
+    handle: *mut TalusComponent,
+    f: impl FnOnce(&mut TalusComponent) -> Result<(), String>,
+) -> c_int {
+    if handle.is_null() {
+        set_error("the component is a null pointer");
+        return TALUS_ERROR;
+    }
+    // SAFETY: a non-null handle comes from `talus_create` and is not yet freed.
+    let h = unsafe { &mut *handle };
+    let result = catch(|| f(h));
+    match result {
+        Ok(()) => TALUS_OK,
+        Err(message) => {
+            if message.starts_with("internal error") {
+                h.component.fail();
+            }
+            set_error(&message);
+            TALUS_ERROR
+        }
+    }
+}
+
+fn wall_name(c: &Component, wall: usize) -> Result<String, String> {
+    c.scene()
+        .world
+        .walls
+        .get(wall)
+        .map(|w| w.name.clone())
+        .ok_or_else(|| {
+            format!(
+                "wall index {wall} out of range (the scene has {})",
+                c.scene().world.walls.len()
+            )
+        })
+}
+
+fn var(c: &Component, name: &str) -> Result<usize, String> {
+    c.variable(name).map_err(|e| e.to_string())
+}
+
+/// The message of the last failed call on this thread ("" if none). Valid until the
+/// next failing call on the thread.
+#[unsafe(no_mangle)]
+pub extern "C" fn talus_last_error() -> *const c_char {
+    LAST_ERROR.with(|e| e.borrow().as_ptr())
+}
+
+/// The talus version.
+#[unsafe(no_mangle)]
+pub extern "C" fn talus_version() -> *const c_char {
+    concat!(env!("CARGO_PKG_VERSION"), "\0").as_ptr().cast()
+}
+
+/// Loads a scene file; null on failure.
+///
+/// # Safety
+/// `scene_path` is a NUL-terminated string.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn talus_create(scene_path: *const c_char) -> *mut TalusComponent {
+    let r = catch(|| {
+        let path = unsafe { text(scene_path, "scene_path") }?;
+        Component::instantiate(Path::new(""), path).map_err(|e| e.to_string())
+    });
+    match r {
+        Ok(component) => Box::into_raw(Box::new(TalusComponent {
+            component,
+            saved: Vec::new(),
+        })),
+        Err(message) => {
+            set_error(&message);
+            std::ptr::null_mut()
+        }
+    }
+}
+
+/// Frees a component (null is ignored); its worker threads have exited on return.
+///
+/// # Safety
+/// `handle` comes from `talus_create` and is not used afterwards.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn talus_free(handle: *mut TalusComponent) {
+    if !handle.is_null() {
+        let _ = catch(|| {
+            drop(unsafe { Box::from_raw(handle) });
+            Ok(())
+        });
+    }
+}
+
+/// Initialises at `start_time` (enter and exit initialisation).
+///
+/// # Safety
+/// `handle` is a live component.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn talus_initialize(handle: *mut TalusComponent, start_time: f64) -> c_int {
+    with(handle, |h| {
+        h.component
+            .enter_initialization_mode(start_time)
+            .and_then(|_| h.component.exit_initialization_mode())
+            .map_err(|e| e.to_string())
+    })
+}
+
+/// Advances from `t` (the current time) by `h`.
+///
+/// # Safety
+/// `handle` is a live component.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn talus_step(handle: *mut TalusComponent, t: f64, h: f64) -> c_int {
+    with(handle, |c| {
+        c.component.do_step(t, h).map_err(|e| e.to_string())
+    })
+}
+
+/// Ends the run (writes the last output if an output directory is set).
+///
+/// # Safety
+/// `handle` is a live component.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn talus_terminate(handle: *mut TalusComponent) -> c_int {
+    with(handle, |c| {
+        c.component.terminate().map_err(|e| e.to_string())
+    })
+}
+
+/// Simulated time.
+///
+/// # Safety
+/// `handle` is a live component, `time` writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn talus_time(handle: *mut TalusComponent, time: *mut f64) -> c_int {
+    with(handle, |c| {
+        let t = c
+            .component
+            .simulation()
+            .ok_or("the component is not initialised")?
+            .world
+            .time;
+        unsafe { put(time, t, "time") }
+    })
+}
+
+/// Number of walls.
+///
+/// # Safety
+/// `handle` is a live component, `count` writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn talus_wall_count(handle: *mut TalusComponent, count: *mut usize) -> c_int {
+    with(handle, |c| unsafe {
+        put(count, c.component.scene().world.walls.len(), "count")
+    })
+}
+
+/// Index of the wall called `name`.
+///
+/// # Safety
+/// `handle` is a live component, `name` a C string, `index` writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn talus_wall_index(
+    handle: *mut TalusComponent,
+    name: *const c_char,
+    index: *mut usize,
+) -> c_int {
+    with(handle, |c| {
+        let name = unsafe { text(name, "name") }?;
+        let w = c
+            .component
+            .wall(name)
+            .ok_or_else(|| format!("no wall called '{name}'"))?;
+        unsafe { put(index, w, "index") }
+    })
+}
+
+/// Sets the velocity inputs of a wall driven from outside by velocity (held from the
+/// next step on).
+///
+/// # Safety
+/// `handle` is a live component; `velocity` and `angular_velocity` hold 3 values.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn talus_set_wall_velocity(
+    handle: *mut TalusComponent,
+    wall: usize,
+    velocity: *const f64,
+    angular_velocity: *const f64,
+) -> c_int {
+    with(handle, |h| {
+        let c = &mut h.component;
+        let name = wall_name(c, wall)?;
+        let v = unsafe { slice(velocity, 3, "velocity") }?;
+        let w = unsafe { slice(angular_velocity, 3, "angular_velocity") }?;
+        let (vv, vw) = (
+            var(c, &format!("{name}.velocity")),
+            var(c, &format!("{name}.angular_velocity")),
+        );
+        let (Ok(vv), Ok(vw)) = (vv, vw) else {
+            return Err(format!(
+                "wall '{name}' is not driven from outside by velocity"
+            ));
+        };
+        let mut refs = Vec::new();
+        let mut values = Vec::new();
+        for (var, x) in [(vv, v), (vw, w)] {
+            for (element, value) in x.iter().enumerate() {
+                refs.push(crate::cosim::VarRef { var, element });
+                values.push(*value);
+            }
+        }
+        c.set_real(&refs, &values).map_err(|e| e.to_string())
+    })
+}
+
+/// Sets the pose inputs of a wall driven from outside by pose: where its reference
+/// point and orientation (w, x, y, z) are at the end of the next step.
+///
+/// # Safety
+/// `handle` is a live component; `position` holds 3 values, `orientation` 4.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn talus_set_wall_pose(
+    handle: *mut TalusComponent,
+    wall: usize,
+    position: *const f64,
+    orientation: *const f64,
+) -> c_int {
+    with(handle, |h| {
+        let c = &mut h.component;
+        let name = wall_name(c, wall)?;
+        let p = unsafe { slice(position, 3, "position") }?;
+        let q = unsafe { slice(orientation, 4, "orientation") }?;
+        let (vp, vq) = (
+            var(c, &format!("{name}.position")),
+            var(c, &format!("{name}.orientation")),
+        );
+        let (Ok(vp), Ok(vq)) = (vp, vq) else {
+            return Err(format!("wall '{name}' is not driven from outside by pose"));
+        };
+        let mut refs = Vec::new();
+        let mut values = Vec::new();
+        for (var, x) in [(vp, p), (vq, q)] {
+            for (element, value) in x.iter().enumerate() {
+                refs.push(crate::cosim::VarRef { var, element });
+                values.push(*value);
+            }
+        }
+        c.set_real(&refs, &values).map_err(|e| e.to_string())
+    })
+}
+
+fn wall_pair(
+    h: &mut TalusComponent,
+    wall: usize,
+    names: [&str; 2],
+    force: *mut f64,
+    torque: *mut f64,
+) -> Result<(), String> {
+    let c = &h.component;
+    let name = wall_name(c, wall)?;
+    let f = c
+        .get_real_vector(var(c, &format!("{name}.{}", names[0]))?)
+        .map_err(|e| e.to_string())?;
+    let t = c
+        .get_real_vector(var(c, &format!("{name}.{}", names[1]))?)
+        .map_err(|e| e.to_string())?;
+    unsafe { slice_mut(force, 3, "force") }?.copy_from_slice(&f);
+    unsafe { slice_mut(torque, 3, "torque") }?.copy_from_slice(&t);
+    Ok(())
+}
+
+/// Mean force and torque (about the wall's reference point) of the particles on a
+/// wall over the last step: impulse divided by the step.
+///
+/// # Safety
+/// `handle` is a live component; `force` and `torque` have room for 3 values.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn talus_get_wall_force(
+    handle: *mut TalusComponent,
+    wall: usize,
+    force: *mut f64,
+    torque: *mut f64,
+) -> c_int {
+    with(handle, |h| {
+        wall_pair(h, wall, ["force", "torque"], force, torque)
+    })
+}
+
+/// Force and torque on a wall at the end of the last step.
+///
+/// # Safety
+/// As for `talus_get_wall_force`.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn talus_get_wall_force_end(
+    handle: *mut TalusComponent,
+    wall: usize,
+    force: *mut f64,
+    torque: *mut f64,
+) -> c_int {
+    with(handle, |h| {
+        wall_pair(h, wall, ["force_end", "torque_end"], force, torque)
+    })
+}
+
+/// Sizes of a wall's mesh.
+///
+/// # Safety
+/// `handle` is a live component; `vertices` and `triangles` writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn talus_get_wall_mesh_size(
+    handle: *mut TalusComponent,
+    wall: usize,
+    vertices: *mut usize,
+    triangles: *mut usize,
+) -> c_int {
+    with(handle, |h| {
+        let mesh = h
+            .component
+            .wall_mesh(wall)
+            .ok_or_else(|| wall_name(&h.component, wall).unwrap_err())?;
+        unsafe { put(vertices, mesh.vertices.len(), "vertices") }?;
+        unsafe { put(triangles, mesh.triangles.len(), "triangles") }
+    })
+}
+
+/// A wall's mesh as placed now: `3 n_vertices` coordinates and `3 n_triangles`
+/// vertex indices (counter-clockwise seen from the particles).
+///
+/// # Safety
+/// `handle` is a live component; the arrays have the sizes given.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn talus_get_wall_mesh(
+    handle: *mut TalusComponent,
+    wall: usize,
+    vertices: *mut f64,
+    n_vertices: usize,
+    triangles: *mut u32,
+    n_triangles: usize,
+) -> c_int {
+    with(handle, |h| {
+        let mesh = h
+            .component
+            .wall_mesh(wall)
+            .ok_or_else(|| wall_name(&h.component, wall).unwrap_err())?;
+        if n_vertices != mesh.vertices.len() || n_triangles != mesh.triangles.len() {
+            return Err(format!(
+                "the mesh has {} vertices and {} triangles, not {n_vertices} and {n_triangles}",
+                mesh.vertices.len(),
+                mesh.triangles.len()
+            ));
+        }
+        let v = unsafe { slice_mut(vertices, 3 * n_vertices, "vertices") }?;
+        for (out, p) in v.chunks_exact_mut(3).zip(&mesh.vertices) {
+            out.copy_from_slice(p.coords.as_slice());
+        }
+        let t = unsafe { slice_mut(triangles, 3 * n_triangles, "triangles") }?;
+        for (out, tri) in t.chunks_exact_mut(3).zip(mesh.triangles) {
+            out.copy_from_slice(tri);
+        }
+        Ok(())
+    })
+}
+
+/// The force on each facet of a wall at the end of the last step (`3 n_triangles`
+/// values).
+///
+/// # Safety
+/// `handle` is a live component; `forces` has room for `3 n_triangles` values.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn talus_get_facet_forces(
+    handle: *mut TalusComponent,
+    wall: usize,
+    forces: *mut f64,
+    n_triangles: usize,
+) -> c_int {
+    with(handle, |h| {
+        let c = &h.component;
+        let name = wall_name(c, wall)?;
+        let f = c
+            .get_real_vector(var(c, &format!("{name}.facet_force"))?)
+            .map_err(|e| e.to_string())?;
+        if f.len() != 3 * n_triangles {
+            return Err(format!(
+                "the wall has {} facets, not {n_triangles}",
+                f.len() / 3
+            ));
+        }
+        unsafe { slice_mut(forces, f.len(), "forces") }?.copy_from_slice(&f);
+        Ok(())
+    })
+}
+
+/// Reads the `n` values of the real variable called `name`.
+///
+/// # Safety
+/// `handle` is a live component, `name` a C string, `values` has room for `n`.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn talus_get_real(
+    handle: *mut TalusComponent,
+    name: *const c_char,
+    values: *mut f64,
+    n: usize,
+) -> c_int {
+    with(handle, |h| {
+        let c = &h.component;
+        let name = unsafe { text(name, "name") }?;
+        let x = c
+            .get_real_vector(var(c, name)?)
+            .map_err(|e| e.to_string())?;
+        if x.len() != n {
+            return Err(format!("variable '{name}' has {} values, not {n}", x.len()));
+        }
+        unsafe { slice_mut(values, n, "values") }?.copy_from_slice(&x);
+        Ok(())
+    })
+}
+
+/// Sets the `n` values of the real variable called `name`.
+///
+/// # Safety
+/// `handle` is a live component, `name` a C string, `values` holds `n` values.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn talus_set_real(
+    handle: *mut TalusComponent,
+    name: *const c_char,
+    values: *const f64,
+    n: usize,
+) -> c_int {
+    with(handle, |h| {
+        let c = &mut h.component;
+        let name = unsafe { text(name, "name") }?;
+        let v = var(c, name)?;
+        let size = c.variables()[v].size;
+        if size != n {
+            return Err(format!("variable '{name}' has {size} values, not {n}"));
+        }
+        let x = unsafe { slice(values, n, "values") }?;
+        c.set_real_vector(v, x).map_err(|e| e.to_string())
+    })
+}
+
+/// Saves the whole state; `*bytes` points to `*size` bytes owned by the component,
+/// valid until the next save or `talus_free`.
+///
+/// # Safety
+/// `handle` is a live component; `bytes` and `size` writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn talus_save_state(
+    handle: *mut TalusComponent,
+    bytes: *mut *const u8,
+    size: *mut usize,
+) -> c_int {
+    with(handle, |h| {
+        let state = h.component.save_state().map_err(|e| e.to_string())?;
+        h.saved = h.component.state_to_bytes(&state);
+        unsafe { put(bytes, h.saved.as_ptr(), "bytes") }?;
+        unsafe { put(size, h.saved.len(), "size") }
+    })
+}
+
+/// Restores a state saved by `talus_save_state` (of the same scene).
+///
+/// # Safety
+/// `handle` is a live component; `bytes` holds `size` bytes.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn talus_restore_state(
+    handle: *mut TalusComponent,
+    bytes: *const u8,
+    size: usize,
+) -> c_int {
+    with(handle, |h| {
+        let b = unsafe { slice(bytes, size, "bytes") }?;
+        let state = h.component.state_from_bytes(b).map_err(|e| e.to_string())?;
+        h.component.restore_state(&state).map_err(|e| e.to_string())
+    })
+}
