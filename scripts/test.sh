@@ -13,3 +13,9 @@ echo "== tests"
 cargo test --locked --all-targets
 echo "== benchmarks build"
 cargo bench --locked --no-run
+echo "== Python tests (fmpy)"
+# The talus program and libtalus.so they pack into FMUs (built by the tests above;
+# this only makes sure).
+cargo build --locked
+scripts/python-env.sh tests/python/requirements.txt
+.venv/bin/python -m pytest tests/python -q

@@ -28,6 +28,7 @@ pub mod contact;
 pub mod cosim;
 pub mod engine;
 pub mod ffi;
+pub mod fmi;
 pub mod geometry;
 pub mod output;
 pub mod scene;

@@ -2,6 +2,7 @@
 
 mod bench;
 mod contact;
+mod fmu;
 mod run;
 
 use std::path::{Path, PathBuf};
@@ -41,6 +42,20 @@ enum Command {
         /// No progress bar.
         #[arg(long)]
         quiet: bool,
+    },
+    /// Pack a scene as an FMI 2.0 or 3.0 Co-Simulation FMU.
+    Fmu {
+        /// The scene (TOML).
+        scene: PathBuf,
+        /// The FMU to write.
+        #[arg(short, long)]
+        output: PathBuf,
+        /// FMI version: 2 or 3.
+        #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u8).range(2..=3))]
+        fmi: u8,
+        /// The talus shared library to pack (default: libtalus.so next to this program).
+        #[arg(long)]
+        library: Option<PathBuf>,
     },
     /// Report the shapes of a two-body file and their contact (GJK, overlap volume,
     /// contact point, normal, area), with the time each kernel takes.
@@ -88,6 +103,12 @@ fn main() -> Result<()> {
             },
         ),
         Command::Contact { file } => contact::contact(&file),
+        Command::Fmu {
+            scene,
+            output,
+            fmi,
+            library,
+        } => fmu::fmu(&scene, &output, fmi, library),
         Command::Bench { scale, steps } => bench::bench(bench::BenchOptions { scale, steps }),
         Command::Inspect { mesh, hull, scale } => {
             let spec = ShapeSpec::Mesh {

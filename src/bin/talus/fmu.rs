@@ -1,0 +1,44 @@
+//! `talus fmu`: pack a scene as an FMU.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result, bail};
+use talus::fmi::description::FmiVersion;
+use talus::fmi::package::write_fmu;
+
+/// The shared library next to the running program (`target/<profile>/libtalus.so`).
+fn default_library() -> Result<PathBuf> {
+    let exe = std::env::current_exe().context("cannot locate the talus program")?;
+    let lib = exe.with_file_name("libtalus.so");
+    if !lib.is_file() {
+        bail!(
+            "no shared library at {}: build it with `cargo build --release` (it is built with \
+             the talus program) or give --library",
+            lib.display()
+        );
+    }
+    Ok(lib)
+}
+
+pub fn fmu(scene: &Path, output: &Path, fmi: u8, library: Option<PathBuf>) -> Result<()> {
+    let library = match library {
+        Some(l) => l,
+        None => default_library()?,
+    };
+    let version = if fmi == 3 {
+        FmiVersion::Three
+    } else {
+        FmiVersion::Two
+    };
+    let summary = write_fmu(scene, &library, version, output)
+        .with_context(|| format!("cannot pack {}", scene.display()))?;
+    println!(
+        "{}: FMI {fmi}.0 co-simulation FMU, {} variables, guid {}, {} resource file(s), {:.1} MB",
+        output.display(),
+        summary.variables,
+        summary.guid,
+        summary.resources.len(),
+        summary.bytes as f64 / 1e6
+    );
+    Ok(())
+}
