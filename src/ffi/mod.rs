@@ -511,3 +511,50 @@ pub unsafe extern "C" fn talus_restore_state(
         h.component.restore_state(&state).map_err(|e| e.to_string())
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cosim::Mode;
+    use std::ffi::CStr;
+
+    fn drum() -> *mut TalusComponent {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/drum_fmu/drum.toml\0");
+        let h = unsafe { talus_create(path.as_ptr().cast()) };
+        assert!(!h.is_null());
+        h
+    }
+
+    #[test]
+    fn a_panic_becomes_an_error_status_and_the_error_state() {
+        let h = drum();
+        let status = with(h, |_| panic!("deliberate"));
+        assert_eq!(status, TALUS_ERROR);
+        let message = unsafe { CStr::from_ptr(talus_last_error()) }
+            .to_string_lossy()
+            .into_owned();
+        assert!(
+            message.contains("panic") && message.contains("deliberate"),
+            "{message}"
+        );
+        assert_eq!(unsafe { &*h }.component.mode(), Mode::Error);
+        // Nothing but free works afterwards.
+        assert_eq!(unsafe { talus_initialize(h, 0.0) }, TALUS_ERROR);
+        unsafe { talus_free(h) };
+    }
+
+    #[test]
+    fn null_handles_and_pointers_are_refused() {
+        assert_eq!(
+            unsafe { talus_initialize(std::ptr::null_mut(), 0.0) },
+            TALUS_ERROR
+        );
+        assert!(unsafe { talus_create(std::ptr::null()) }.is_null());
+        let h = drum();
+        assert_eq!(
+            unsafe { talus_wall_count(h, std::ptr::null_mut()) },
+            TALUS_ERROR
+        );
+        unsafe { talus_free(h) };
+    }
+}

@@ -272,6 +272,42 @@ pub(crate) fn free_instance(ptr: *mut c_void) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::cosim::Mode;
+
+    #[test]
+    fn a_panic_in_an_entry_point_is_logged_and_leaves_the_error_state() {
+        let dir = std::env::temp_dir().join(format!("talus-fmi-panic-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/drum_fmu/drum.toml");
+        std::fs::copy(scene, dir.join(SCENE_FILE)).unwrap();
+        let component = Component::instantiate(&dir, SCENE_FILE).unwrap();
+        let token = guid(component.fingerprint());
+        let inst = Instance::create(
+            "x",
+            &token,
+            dir.clone(),
+            LogSink::Fmi3(None, std::ptr::null_mut()),
+            true,
+        )
+        .unwrap();
+        assert!(
+            Instance::create(
+                "x",
+                "{wrong}",
+                dir,
+                LogSink::Fmi3(None, std::ptr::null_mut()),
+                true
+            )
+            .is_err()
+        );
+        let ptr = Box::into_raw(Box::new(inst)) as *mut c_void;
+        assert_eq!(on_instance(ptr, "test", |_| panic!("deliberate")), ERROR);
+        let inst = unsafe { &*(ptr as *mut Instance) };
+        assert_eq!(inst.component.mode(), Mode::Error);
+        assert_eq!(unsupported(ptr, "fmi3EnterEventMode"), ERROR);
+        free_instance(ptr);
+        assert_eq!(on_instance(std::ptr::null_mut(), "test", |_| Ok(OK)), ERROR);
+    }
 
     #[test]
     fn resource_uris_become_paths() {
