@@ -346,3 +346,30 @@ fn tempdir(name: &str) -> std::path::PathBuf {
     std::fs::create_dir_all(&dir).unwrap();
     dir
 }
+
+#[test]
+fn the_output_dir_parameter_writes_the_run_files_while_stepping() {
+    let dir = tempdir("output");
+    let mut c = drum("drum.toml");
+    let out = c.variable("output_dir").unwrap();
+    let target = dir.join("run");
+    c.set_string(
+        &[VarRef {
+            var: out,
+            element: 0,
+        }],
+        &[target.to_str().unwrap()],
+    )
+    .unwrap();
+    c.enter_initialization_mode(0.0).unwrap();
+    c.exit_initialization_mode().unwrap();
+    set_spin(&mut c, 3.0);
+    c.do_step(0.0, 0.06).unwrap();
+    c.terminate().unwrap();
+    let walls = std::fs::read_to_string(target.join("walls.csv")).unwrap();
+    // Rows every 10 ms (the scene's csv_interval) from 0 to 0.06 s.
+    assert_eq!(walls.lines().count(), 1 + 7, "{walls}");
+    assert!(walls.starts_with("time,drum_fx"));
+    assert!(target.join("particles.pvd").is_file());
+    assert!(target.join("walls.pvd").is_file());
+}
