@@ -4,18 +4,20 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-# The Rust toolchain is the machine's own; rustfmt and clippy come with it.
+# The Rust toolchain is the machine's own; rustfmt and clippy come with it. Feature
+# sets built: default (no zenoh) and `zenoh` (the transport; its protoc is vendored).
 echo "== format"
 cargo fmt --check
-echo "== clippy"
+echo "== clippy (default features, then --features zenoh)"
 cargo clippy --all-targets --locked -- -D warnings
-echo "== tests"
-cargo test --locked --all-targets
+cargo clippy --all-targets --locked --features zenoh -- -D warnings
+echo "== tests (--features zenoh: everything)"
+cargo test --locked --all-targets --features zenoh
 echo "== benchmarks build"
 cargo bench --locked --no-run
-echo "== Python tests (fmpy)"
-# The talus program and libtalus.so they pack into FMUs (built by the tests above;
-# this only makes sure).
-cargo build --locked
+echo "== Python tests (fmpy, zenoh client)"
+# The talus program and libtalus.so they drive (built by the tests above; this only
+# makes sure).
+cargo build --locked --features zenoh
 scripts/python-env.sh tests/python/requirements.txt
 .venv/bin/python -m pytest tests/python -q

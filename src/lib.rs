@@ -18,6 +18,7 @@
 //!   variable table, communication steps, saved states).
 //! - [`ffi`], [`fmi`]: the C ABI over the component (native C API; FMI 2.0 and 3.0
 //!   Co-Simulation entry points and FMU packaging).
+//! - `transport` (feature `zenoh`): the zenoh node over the component.
 //! - [`output`]: ParaView series, CSV time series, run summary.
 
 // `!(x > 0.0)` is how talus rejects NaN along with non-positive values; clippy's
@@ -32,6 +33,8 @@ pub mod fmi;
 pub mod geometry;
 pub mod output;
 pub mod scene;
+#[cfg(feature = "zenoh")]
+pub mod transport;
 pub mod world;
 
 /// The scalar type used throughout talus.

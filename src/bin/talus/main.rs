@@ -4,6 +4,8 @@ mod bench;
 mod contact;
 mod fmu;
 mod run;
+#[cfg(feature = "zenoh")]
+mod serve;
 
 use std::path::{Path, PathBuf};
 
@@ -57,6 +59,35 @@ enum Command {
         #[arg(long)]
         library: Option<PathBuf>,
     },
+    /// Serve a scene as a zenoh node (feature `zenoh`): queryables KEY/step,
+    /// KEY/walls, KEY/info, KEY/state, publisher KEY/forces, liveliness token KEY.
+    #[cfg(feature = "zenoh")]
+    Serve {
+        /// The scene (TOML).
+        scene: PathBuf,
+        /// Key prefix, e.g. talus/drum.
+        #[arg(long)]
+        key: String,
+        /// Endpoint to listen on (repeatable), e.g. tcp/127.0.0.1:7447.
+        #[arg(long)]
+        listen: Vec<String>,
+        /// Endpoint to connect to (repeatable).
+        #[arg(long)]
+        connect: Vec<String>,
+        /// Enable multicast scouting (off by default).
+        #[arg(long)]
+        multicast: bool,
+        /// Output directory (default: the scene's).
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
+    /// Write the Python classes of the zenoh messages (feature `zenoh`).
+    #[cfg(feature = "zenoh")]
+    Proto {
+        /// Directory for talus/v1/talus_pb2.py.
+        #[arg(long)]
+        python_out: PathBuf,
+    },
     /// Report the shapes of a two-body file and their contact (GJK, overlap volume,
     /// contact point, normal, area), with the time each kernel takes.
     Contact {
@@ -103,6 +134,26 @@ fn main() -> Result<()> {
             },
         ),
         Command::Contact { file } => contact::contact(&file),
+        #[cfg(feature = "zenoh")]
+        Command::Serve {
+            scene,
+            key,
+            listen,
+            connect,
+            multicast,
+            out,
+        } => serve::serve(
+            &scene,
+            serve::ServeOptions {
+                key,
+                listen,
+                connect,
+                multicast,
+                out,
+            },
+        ),
+        #[cfg(feature = "zenoh")]
+        Command::Proto { python_out } => serve::proto_python(&python_out),
         Command::Fmu {
             scene,
             output,

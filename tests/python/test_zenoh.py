@@ -1,0 +1,192 @@
+"""The zenoh node (`talus serve`) driven by the Python client: forces equal to the
+component's, published steps in order, bad requests answered, disconnects, two
+clients, and a clean stop on SIGTERM. Loopback only, one port per test."""
+import ctypes
+import math
+import os
+import signal
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import pytest
+
+from conftest import ROOT, SCENES, TALUS
+
+sys.path.insert(0, str(ROOT / "interfaces" / "python"))
+from talus_client import TalusError, connect  # noqa: E402
+
+PORT_BASE = 17400 + (os.getpid() % 400) * 8
+_ports = iter(range(PORT_BASE, PORT_BASE + 8))
+
+
+@pytest.fixture(scope="module")
+def proto_dir(tmp_path_factory):
+    out = tmp_path_factory.mktemp("proto")
+    subprocess.run([str(TALUS), "proto", "--python-out", str(out)], check=True, capture_output=True)
+    return out
+
+
+class Server:
+    def __init__(self, scene, out):
+        self.port = next(_ports)
+        self.endpoint = f"tcp/127.0.0.1:{self.port}"
+        self.key = f"talus/test{self.port}"
+        self.out = out
+        self.process = subprocess.Popen(
+            [str(TALUS), "serve", str(scene), "--key", self.key, "--listen", self.endpoint,
+             "--out", str(out)],
+            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+
+    def client(self, proto_dir, timeout=60.0):
+        deadline = time.time() + 60
+        while True:
+            c = connect(self.key, self.endpoint, proto_dir, timeout)
+            try:
+                c.wait_until_served(timeout=2.0)
+                return c
+            except TimeoutError:
+                c.close()
+                if time.time() > deadline or self.process.poll() is not None:
+                    raise RuntimeError(f"server did not come up: {self.process.communicate()}")
+
+    def stop(self):
+        if self.process.poll() is None:
+            self.process.send_signal(signal.SIGTERM)
+        return self.process.wait(timeout=60)
+
+
+@pytest.fixture
+def drum_server(tmp_path):
+    server = Server(SCENES["drum"], tmp_path / "out")
+    yield server
+    if server.process.poll() is None:
+        server.process.kill()
+        server.process.wait()
+
+
+def spin(omega):
+    return {"drum": {"angular_velocity": (0.0, omega, 0.0)}}
+
+
+def test_the_client_gets_the_forces_of_the_component_stepped_directly(drum_server, proto_dir):
+    with drum_server.client(proto_dir) as client:
+        info = client.info()
+        assert [w.name for w in info.walls] == ["drum"] and info.walls[0].drive == "velocity"
+        assert any(v.name == "drum.torque" and v.unit == "N.m" for v in info.variables)
+        lib = ctypes.CDLL(str(TALUS.with_name("libtalus.so")))
+        lib.talus_create.restype = ctypes.c_void_p
+        handle = ctypes.c_void_p(lib.talus_create(str(SCENES["drum"]).encode()))
+        assert handle.value and lib.talus_initialize(handle, ctypes.c_double(0.0)) == 0
+        f, m = (ctypes.c_double * 3)(), (ctypes.c_double * 3)()
+        t = 0.0
+        for k, omega in enumerate([3.0, 3.0, -3.0, 1.5]):
+            h = 0.013 + 0.01 * k
+            reply = client.step(t, h, spin(omega))
+            assert lib.talus_set_wall_velocity(handle, ctypes.c_size_t(0), (ctypes.c_double * 3)(),
+                                               (ctypes.c_double * 3)(0.0, omega, 0.0)) == 0
+            assert lib.talus_step(handle, ctypes.c_double(t), ctypes.c_double(h)) == 0
+            t += h
+            assert lib.talus_get_wall_force(handle, ctypes.c_size_t(0), f, m) == 0
+            w = reply.walls[0]
+            assert reply.time == t and reply.sequence == k + 1
+            assert [w.torque.x, w.torque.y, w.torque.z] == list(m)
+            assert [w.force.x, w.force.y, w.force.z] == list(f)
+            assert reply.globals.particles == 96
+        lib.talus_free(handle)
+        mesh = client.walls(facet_forces=True).walls[0]
+        assert len(mesh.vertices) % 3 == 0 and len(mesh.facet_forces) == len(mesh.triangles)
+        # Save, step, restore, step: the same reply.
+        state = client.save()
+        a = client.step(t, 0.01, spin(3.0))
+        client.restore(state)
+        b = client.step(t, 0.01, spin(3.0))
+        assert a.walls[0].torque == b.walls[0].torque and a.time == b.time
+
+
+def test_a_subscriber_receives_every_step_in_order(drum_server, proto_dir):
+    with drum_server.client(proto_dir) as stepper, drum_server.client(proto_dir) as watcher:
+        seen = []
+        done = threading.Event()
+
+        def on_step(reply):
+            seen.append((reply.sequence, reply.time))
+            if len(seen) == 20:
+                done.set()
+
+        watcher.subscribe(on_step)
+        time.sleep(0.5)
+        t = 0.0
+        for _ in range(20):
+            stepper.step(t, 0.002, spin(3.0))
+            t += 0.002
+        assert done.wait(30), seen
+        assert [s for s, _ in seen] == list(range(1, 21))
+        assert all(b > a for (_, a), (_, b) in zip(seen, seen[1:]))
+
+
+def test_bad_requests_get_error_replies_and_change_nothing(drum_server, proto_dir):
+    with drum_server.client(proto_dir) as client:
+        pb = client.pb
+        client.step(0.0, 0.005, spin(3.0))
+        bad = [
+            ("step", b"\xff\xff\xff\xff", pb.StepReply, "malformed"),
+            ("walls", b"\x0a\xff", pb.WallsReply, "malformed"),
+            ("state", b"\x12\x05abc", pb.StateReply, "malformed"),
+            ("state", pb.StateRequest(restore=b"garbage").SerializeToString(), pb.StateReply, "not a talus state"),
+            ("state", b"", pb.StateReply, "save or restore"),
+        ]
+        for endpoint, payload, reply_type, words in bad:
+            reply = client.raw(endpoint, payload, reply_type)
+            assert reply.status == pb.STATUS_ERROR and words in reply.error, (endpoint, reply)
+        for h in (0.0, float("nan"), -0.01):
+            reply = client.step(0.005, h, spin(3.0), check=False)
+            assert reply.status == pb.STATUS_ERROR and "positive" in reply.error
+        reply = client.step(0.005, 0.01, {"lid": {"angular_velocity": (0, 1, 0)}}, check=False)
+        assert reply.status == pb.STATUS_ERROR and "lid" in reply.error
+        reply = client.step(0.005, 0.01, {"drum": {"position": (0, 0, 0)}}, check=False)
+        assert reply.status == pb.STATUS_ERROR and "not driven" in reply.error
+        reply = client.step(0.005, 0.01, spin(float("inf")), check=False)
+        assert reply.status == pb.STATUS_ERROR and "not finite" in reply.error
+        reply = client.step(0.5, 0.01, spin(3.0), check=False)
+        assert reply.status == pb.STATUS_ERROR and "starts at" in reply.error
+        with pytest.raises(TalusError):
+            client.walls(["lid"])
+        # Nothing changed: the next valid step goes on from 0.005 with sequence 2.
+        reply = client.step(0.005, 0.005, spin(3.0))
+        assert reply.time == 0.01 and reply.sequence == 2
+
+
+def test_clients_that_leave_or_take_turns(drum_server, proto_dir):
+    first = drum_server.client(proto_dir)
+    # A long step whose client goes away before the reply.
+    replies = first.session.get(f"{drum_server.key}/step",
+                                payload=first.pb.StepRequest(time=0.0, step=0.2).SerializeToString(),
+                                timeout=0.05)
+    first.close()
+    del replies
+    with drum_server.client(proto_dir) as a, drum_server.client(proto_dir) as b:
+        t = a.info().time
+        assert abs(t - 0.2) < 1e-12  # the abandoned step was still taken
+        for k in range(4):
+            client = a if k % 2 == 0 else b
+            reply = client.step(t, 0.01, spin(3.0))
+            t += 0.01
+            assert reply.time == t
+        assert b.info().time == t
+
+
+def test_sigterm_stops_the_node_cleanly_with_its_outputs(drum_server, proto_dir):
+    with drum_server.client(proto_dir) as client:
+        t = 0.0
+        for _ in range(3):
+            client.step(t, 0.02, spin(3.0))
+            t += 0.02
+    assert drum_server.stop() == 0
+    stdout = drum_server.process.stdout.read()
+    assert "stopped at t = 0.06" in stdout, stdout
+    walls = (drum_server.out / "walls.csv").read_text().splitlines()
+    assert walls[0].startswith("time,drum_fx") and len(walls) >= 7
+    assert (drum_server.out / "particles.pvd").is_file()
