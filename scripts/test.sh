@@ -11,13 +11,12 @@ cargo fmt --check
 echo "== clippy (default features, then --features zenoh)"
 cargo clippy --all-targets --locked -- -D warnings
 cargo clippy --all-targets --locked --features zenoh -- -D warnings
+echo "== build (the talus program and libtalus.so, used by the C, FMU and zenoh tests)"
+cargo build --locked --features zenoh
 echo "== tests (--features zenoh: everything)"
 cargo test --locked --all-targets --features zenoh
 echo "== benchmarks build"
 cargo bench --locked --no-run
 echo "== Python tests (fmpy, zenoh client)"
-# The talus program and libtalus.so they drive (built by the tests above; this only
-# makes sure).
-cargo build --locked --features zenoh
 scripts/python-env.sh tests/python/requirements.txt
 .venv/bin/python -m pytest tests/python -q

@@ -79,6 +79,28 @@ fn var(c: &Component, name: &str) -> Result<usize, String> {
     c.variable(name).map_err(|e| e.to_string())
 }
 
+/// Sets the two input variables `wall.suffix` of a wall driven by `kind`, all or
+/// none.
+fn set_wall_inputs(
+    c: &mut Component,
+    wall: usize,
+    inputs: [(&str, &[f64]); 2],
+    kind: &str,
+) -> Result<(), String> {
+    let name = wall_name(c, wall)?;
+    let mut refs = Vec::new();
+    let mut values = Vec::new();
+    for (suffix, x) in inputs {
+        let var = var(c, &format!("{name}.{suffix}"))
+            .map_err(|_| format!("wall '{name}' is not driven from outside by {kind}"))?;
+        for (element, value) in x.iter().enumerate() {
+            refs.push(crate::cosim::VarRef { var, element });
+            values.push(*value);
+        }
+    }
+    c.set_real(&refs, &values).map_err(|e| e.to_string())
+}
+
 /// The message of the last failed call on this thread ("" if none). Valid until the
 /// next failing call on the thread.
 #[unsafe(no_mangle)]
@@ -225,28 +247,14 @@ pub unsafe extern "C" fn talus_set_wall_velocity(
     angular_velocity: *const f64,
 ) -> c_int {
     with(handle, |h| {
-        let c = &mut h.component;
-        let name = wall_name(c, wall)?;
         let v = unsafe { slice(velocity, 3, "velocity") }?;
         let w = unsafe { slice(angular_velocity, 3, "angular_velocity") }?;
-        let (vv, vw) = (
-            var(c, &format!("{name}.velocity")),
-            var(c, &format!("{name}.angular_velocity")),
-        );
-        let (Ok(vv), Ok(vw)) = (vv, vw) else {
-            return Err(format!(
-                "wall '{name}' is not driven from outside by velocity"
-            ));
-        };
-        let mut refs = Vec::new();
-        let mut values = Vec::new();
-        for (var, x) in [(vv, v), (vw, w)] {
-            for (element, value) in x.iter().enumerate() {
-                refs.push(crate::cosim::VarRef { var, element });
-                values.push(*value);
-            }
-        }
-        c.set_real(&refs, &values).map_err(|e| e.to_string())
+        set_wall_inputs(
+            &mut h.component,
+            wall,
+            [("velocity", v), ("angular_velocity", w)],
+            "velocity",
+        )
     })
 }
 
@@ -263,26 +271,14 @@ pub unsafe extern "C" fn talus_set_wall_pose(
     orientation: *const f64,
 ) -> c_int {
     with(handle, |h| {
-        let c = &mut h.component;
-        let name = wall_name(c, wall)?;
         let p = unsafe { slice(position, 3, "position") }?;
         let q = unsafe { slice(orientation, 4, "orientation") }?;
-        let (vp, vq) = (
-            var(c, &format!("{name}.position")),
-            var(c, &format!("{name}.orientation")),
-        );
-        let (Ok(vp), Ok(vq)) = (vp, vq) else {
-            return Err(format!("wall '{name}' is not driven from outside by pose"));
-        };
-        let mut refs = Vec::new();
-        let mut values = Vec::new();
-        for (var, x) in [(vp, p), (vq, q)] {
-            for (element, value) in x.iter().enumerate() {
-                refs.push(crate::cosim::VarRef { var, element });
-                values.push(*value);
-            }
-        }
-        c.set_real(&refs, &values).map_err(|e| e.to_string())
+        set_wall_inputs(
+            &mut h.component,
+            wall,
+            [("position", p), ("orientation", q)],
+            "pose",
+        )
     })
 }
 

@@ -3,11 +3,12 @@
 
 use std::ffi::{c_char, c_int, c_uint, c_void};
 
+use super::state::{deserialise, free_state, get_state, serialise, serialised_size, set_state};
 use super::{
     ERROR, Fmi2Logger, Instance, LogSink, OK, free_instance, log_to, on_instance, resource_dir,
     unsupported,
 };
-use crate::cosim::{ComponentState, Mode, VarRef};
+use crate::cosim::{Mode, VarRef};
 use crate::ffi::guard::{catch, put, slice, slice_mut, text};
 
 type Component = *mut c_void;
@@ -356,23 +357,6 @@ pub unsafe extern "C" fn fmi2GetFMUstate(c: Component, state: *mut *mut c_void) 
     on_instance(c, "fmi2GetFMUstate", |inst| get_state(inst, state))
 }
 
-/// Saves into a new state, or over the one `*state` points to.
-pub(super) fn get_state(inst: &mut Instance, state: *mut *mut c_void) -> Result<Status, String> {
-    if state.is_null() {
-        return Err("FMUstate is a null pointer".into());
-    }
-    let saved = inst.component.save_state().map_err(|e| e.to_string())?;
-    // SAFETY: checked non-null; a non-null *state came from an earlier GetFMUstate.
-    unsafe {
-        if (*state).is_null() {
-            *state = Box::into_raw(Box::new(saved)) as *mut c_void;
-        } else {
-            *((*state) as *mut ComponentState) = saved;
-        }
-    }
-    Ok(OK)
-}
-
 /// # Safety
 /// FMI 2.0 calling conventions.
 #[unsafe(no_mangle)]
@@ -380,36 +364,11 @@ pub unsafe extern "C" fn fmi2SetFMUstate(c: Component, state: *mut c_void) -> St
     on_instance(c, "fmi2SetFMUstate", |inst| set_state(inst, state))
 }
 
-pub(super) fn set_state(inst: &mut Instance, state: *mut c_void) -> Result<Status, String> {
-    if state.is_null() {
-        return Err("FMUstate is a null pointer".into());
-    }
-    // SAFETY: a state pointer comes from GetFMUstate or DeSerializeFMUstate.
-    let state = unsafe { &*(state as *const ComponentState) };
-    inst.component
-        .restore_state(state)
-        .map_err(|e| e.to_string())?;
-    Ok(OK)
-}
-
 /// # Safety
 /// FMI 2.0 calling conventions.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi2FreeFMUstate(c: Component, state: *mut *mut c_void) -> Status {
     on_instance(c, "fmi2FreeFMUstate", |_| free_state(state))
-}
-
-pub(super) fn free_state(state: *mut *mut c_void) -> Result<Status, String> {
-    if !state.is_null() {
-        // SAFETY: as for set_state; the pointer is cleared after the drop.
-        unsafe {
-            if !(*state).is_null() {
-                drop(Box::from_raw(*state as *mut ComponentState));
-                *state = std::ptr::null_mut();
-            }
-        }
-    }
-    Ok(OK)
 }
 
 /// # Safety
@@ -421,19 +380,8 @@ pub unsafe extern "C" fn fmi2SerializedFMUstateSize(
     size: *mut usize,
 ) -> Status {
     on_instance(c, "fmi2SerializedFMUstateSize", |inst| {
-        let bytes = serialise(inst, state)?;
-        unsafe { put(size, bytes.len(), "size") }?;
-        Ok(OK)
+        serialised_size(inst, state, size)
     })
-}
-
-pub(super) fn serialise(inst: &Instance, state: *mut c_void) -> Result<Vec<u8>, String> {
-    if state.is_null() {
-        return Err("FMUstate is a null pointer".into());
-    }
-    // SAFETY: as for set_state.
-    let state = unsafe { &*(state as *const ComponentState) };
-    Ok(inst.component.state_to_bytes(state))
 }
 
 /// # Safety
@@ -446,12 +394,7 @@ pub unsafe extern "C" fn fmi2SerializeFMUstate(
     size: usize,
 ) -> Status {
     on_instance(c, "fmi2SerializeFMUstate", |inst| {
-        let data = serialise(inst, state)?;
-        if data.len() != size {
-            return Err(format!("the state has {} bytes, not {size}", data.len()));
-        }
-        unsafe { slice_mut(bytes, size, "serializedState") }?.copy_from_slice(&data);
-        Ok(OK)
+        serialise(inst, state, bytes, size)
     })
 }
 
@@ -467,31 +410,6 @@ pub unsafe extern "C" fn fmi2DeSerializeFMUstate(
     on_instance(c, "fmi2DeSerializeFMUstate", |inst| {
         deserialise(inst, bytes, size, state)
     })
-}
-
-pub(super) fn deserialise(
-    inst: &mut Instance,
-    bytes: *const u8,
-    size: usize,
-    state: *mut *mut c_void,
-) -> Result<Status, String> {
-    let data = unsafe { slice(bytes, size, "serializedState") }?;
-    if state.is_null() {
-        return Err("FMUstate is a null pointer".into());
-    }
-    let restored = inst
-        .component
-        .state_from_bytes(data)
-        .map_err(|e| e.to_string())?;
-    // SAFETY: checked non-null; a non-null *state came from an earlier call.
-    unsafe {
-        if (*state).is_null() {
-            *state = Box::into_raw(Box::new(restored)) as *mut c_void;
-        } else {
-            *((*state) as *mut ComponentState) = restored;
-        }
-    }
-    Ok(OK)
 }
 
 /// # Safety

@@ -4,7 +4,7 @@
 
 use std::ffi::{c_char, c_int, c_void};
 
-use super::fmi2::{deserialise, free_state, get_state, serialise, set_state};
+use super::state::{deserialise, free_state, get_state, serialise, serialised_size, set_state};
 use super::{
     ERROR, Fmi3Logger, Instance, LogSink, OK, free_instance, log_to, on_instance, resource_dir,
     unsupported,
@@ -424,9 +424,7 @@ pub unsafe extern "C" fn fmi3SerializedFMUStateSize(
     size: *mut usize,
 ) -> Status {
     on_instance(instance, "fmi3SerializedFMUStateSize", |inst| {
-        let bytes = serialise(inst, state)?;
-        unsafe { put(size, bytes.len(), "size") }?;
-        Ok(OK)
+        serialised_size(inst, state, size)
     })
 }
 
@@ -440,12 +438,7 @@ pub unsafe extern "C" fn fmi3SerializeFMUState(
     size: usize,
 ) -> Status {
     on_instance(instance, "fmi3SerializeFMUState", |inst| {
-        let data = serialise(inst, state)?;
-        if data.len() != size {
-            return Err(format!("the state has {} bytes, not {size}", data.len()));
-        }
-        unsafe { slice_mut(bytes, size, "serializedState") }?.copy_from_slice(&data);
-        Ok(OK)
+        serialise(inst, state, bytes, size)
     })
 }
 
