@@ -12,6 +12,8 @@
 //!   motion, inlets.
 //! - [`engine`]: the CPU time step (broad phase, narrow phase, accumulation,
 //!   integration) and the suggested time step.
+//! - [`analysis`]: figures of a use case read from a running world (the rotating
+//!   drum's drive torque, angle of repose, velocity field).
 //! - [`scene`]: TOML scene files, validated with errors that name file, line and
 //!   field, built into a world and run as a [`scene::Simulation`].
 //! - [`cosim`]: the co-simulation [`cosim::Component`] (FMI-style life cycle,
@@ -25,6 +27,8 @@
 // rewrite to `partial_cmp` would hide that intent.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+pub mod analysis;
+pub mod checksum;
 pub mod contact;
 pub mod cosim;
 pub mod engine;

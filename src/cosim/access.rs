@@ -129,10 +129,35 @@ impl Component {
             Role::WallFacetForces(w) => {
                 sim.map_or(0.0, |s| s.world.walls[w].facet_force[k / 3][k % 3])
             }
+            Role::DriveTorque => self.drum_means().0,
+            Role::DrivePower => self.drum_means().1,
+            Role::AngleOfRepose => match (sim, &self.scene.drum) {
+                (Some(s), Some(d)) => d.surface(&s.world).map_or(0.0, |f| f.slope.atan().abs()),
+                _ => 0.0,
+            },
             Role::Scene | Role::OutputDir | Role::Threads | Role::Particles | Role::Contacts => {
                 unreachable!("not a real variable")
             }
         }
+    }
+
+    /// The drum's mean drive torque about its axis (from the walls' mean forces and
+    /// torques, moved to the axis point where it is at the end of the step) and mean
+    /// power over the last step.
+    fn drum_means(&self) -> (Real, Real) {
+        let (Some(sim), Some(drum)) = (self.sim.as_ref(), &self.scene.drum) else {
+            return (0.0, 0.0);
+        };
+        let (axis, centre) = drum.frame(&sim.world);
+        let mut torque = 0.0;
+        let mut power = 0.0;
+        for &w in &drum.walls {
+            let m = &self.means[w];
+            let arm = sim.world.walls[w].reference() - centre;
+            torque -= (m.torque + arm.cross(&m.force)).dot(&axis);
+            power += m.power;
+        }
+        (torque, power)
     }
 
     /// Sets real values, all or none.

@@ -278,6 +278,7 @@ impl Component {
                 &sim.world,
                 out.frame_interval,
                 out.csv_interval,
+                self.scene.drum.as_ref(),
             )?)
         };
         self.check_orientations()?;
@@ -303,6 +304,7 @@ impl Component {
                 }
             }
         }
+        sim.world.follow_leaders();
         pool.install(|| sim.engine.initialise(&mut sim.world));
         self.means = instantaneous_means(sim);
         self.output = output;
@@ -371,6 +373,7 @@ impl Component {
                 }
             }
         }
+        sim.world.follow_leaders();
         let mut output = self.output.take();
         let result = pool.install(|| -> std::io::Result<()> {
             let mut last = instantaneous_means(sim);
@@ -402,6 +405,7 @@ impl Component {
             wall.pose.translation.vector = position;
             wall.pose.rotation = q;
         }
+        sim.world.follow_leaders();
         self.output = output;
         if let Some(problem) = divergence(sim) {
             *sim = before;
@@ -427,7 +431,8 @@ impl Component {
             "initialisation, step",
         )?;
         if let (Some(out), Some(sim)) = (&mut self.output, &self.sim) {
-            out.record(&sim.world, sim.engine.dt, sim.engine.contacts, true)?;
+            out.record(&sim.world, 0.0, sim.engine.contacts, true)?;
+            out.finish(&sim.world)?;
         }
         self.output = None;
         self.mode = Mode::Terminated;

@@ -89,6 +89,12 @@ pub enum Role {
     WallVertices(usize),
     /// Output (arrays only): force on each facet of wall `w` at the end of the step.
     WallFacetForces(usize),
+    /// Output: mean drive torque of the scene's drum over the last step.
+    DriveTorque,
+    /// Output: mean power the drum delivered over the last step.
+    DrivePower,
+    /// Output: dynamic angle of repose of the drum's bed at the end of the step.
+    AngleOfRepose,
 }
 
 /// One variable.
@@ -285,6 +291,25 @@ pub fn variable_table(scene: &Scene) -> Vec<Variable> {
         facets.array_only = true;
         v.push(facets);
     }
+    if scene.drum.is_some() {
+        v.extend([
+            Variable::new("drive_torque".into(), Role::DriveTorque, Output, 1)
+                .unit("N.m")
+                .about(
+                    "Mean torque the drive applies to the drum about its axis over the last \
+                     step (positive along the axis; balances the bed's resistance)",
+                ),
+            Variable::new("drive_power".into(), Role::DrivePower, Output, 1)
+                .unit("W")
+                .about("Mean power the drum's walls delivered to the bed over the last step"),
+            Variable::new("angle_of_repose".into(), Role::AngleOfRepose, Output, 1)
+                .unit("rad")
+                .about(
+                    "Inclination of the bed's free surface in the drum's central slice at the \
+                     end of the step (0 when no surface is found)",
+                ),
+        ]);
+    }
     v.extend([
         Variable::new("particles".into(), Role::Particles, Output, 1)
             .typed(VarType::Integer)
@@ -309,6 +334,7 @@ pub fn unit_exponents(unit: &str) -> [i32; 4] {
         "m" => [0, 1, 0, 0],
         "m/s" => [0, 1, -1, 0],
         "rad/s" => [0, 0, -1, 1],
+        "rad" => [0, 0, 0, 1],
         "N" => [1, 1, -2, 0],
         "N.m" => [1, 2, -2, 0],
         "J" => [1, 2, -2, 0],

@@ -152,6 +152,7 @@ impl Engine {
         for wall in &mut world.walls {
             wall.advance(world.time, dt);
         }
+        world.follow_leaders();
         world.time += dt;
         self.compute_forces(world);
         let p = &mut world.particles;

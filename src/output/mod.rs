@@ -7,10 +7,13 @@
 //! - `walls.csv`: per wall, the force and torque (about the wall's reference point)
 //!   the particles exert on it, and the power the wall delivers to the particles, each
 //!   the mean over the interval since the previous row (impulse over time, so nothing
-//!   between rows is lost);
+//!   between rows is lost); with a drum, its drive torque and power at the end;
 //! - `series.csv`: particles, contacts, kinetic energy and largest speed;
-//! - `summary.json`: the run's figures.
+//! - `summary.json`: the run's figures;
+//! - with a `[drum]` section, the drum's files (see [`drum`]).
 
+pub mod drum;
+pub mod png;
 pub mod vtk;
 
 use std::fs::File;
@@ -21,7 +24,9 @@ use nalgebra::Vector3;
 use serde::Serialize;
 
 use crate::Real;
+use crate::analysis::{Drum, DrumSummary};
 use crate::world::World;
+use drum::DrumOutput;
 use vtk::Collection;
 
 /// Figures of a finished (or interrupted) run, written as `summary.json`.
@@ -59,6 +64,9 @@ pub struct Summary {
     pub walls: Vec<WallSummary>,
     /// Threads used.
     pub threads: usize,
+    /// The drum's averages, with a `[drum]` section.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub drum: Option<DrumSummary>,
 }
 
 /// A wall's state at the end of a run.
@@ -89,6 +97,7 @@ pub struct RunOutput {
     work: Vec<Real>,
     rows: usize,
     last_frame: Option<Real>,
+    drum: Option<DrumOutput>,
 }
 
 impl RunOutput {
@@ -98,6 +107,7 @@ impl RunOutput {
         world: &World,
         frame_interval: Option<Real>,
         csv_interval: Option<Real>,
+        drum: Option<&Drum>,
     ) -> io::Result<Self> {
         std::fs::create_dir_all(dir.join("frames"))?;
         let mut walls_csv = BufWriter::new(File::create(dir.join("walls.csv"))?);
@@ -106,6 +116,9 @@ impl RunOutput {
             for c in ["fx", "fy", "fz", "tx", "ty", "tz", "power"] {
                 header.push_str(&format!(",{}_{c}", w.name));
             }
+        }
+        if drum.is_some() {
+            header.push_str(",drive_torque,drive_power");
         }
         writeln!(walls_csv, "{header}")?;
         let mut series_csv = BufWriter::new(File::create(dir.join("series.csv"))?);
@@ -128,6 +141,10 @@ impl RunOutput {
             work: vec![0.0; world.walls.len()],
             rows: 0,
             last_frame: None,
+            drum: match drum {
+                Some(d) => Some(DrumOutput::create(dir, d, world)?),
+                None => None,
+            },
         })
     }
 
@@ -150,6 +167,9 @@ impl RunOutput {
         contacts: usize,
         force: bool,
     ) -> io::Result<()> {
+        if let Some(d) = &mut self.drum {
+            d.record(world, dt);
+        }
         for (k, w) in world.walls.iter().enumerate() {
             self.impulses[k][0] += w.force * dt;
             self.impulses[k][1] += w.torque * dt;
@@ -206,6 +226,10 @@ impl RunOutput {
             self.impulses[k] = [Vector3::zeros(); 2];
             self.work[k] = 0.0;
         }
+        if let Some(d) = &mut self.drum {
+            let r = d.write_row(world)?;
+            row.push_str(&format!(",{:.9e},{:.9e}", r.drive_torque, r.power));
+        }
         writeln!(self.walls_csv, "{row}")?;
         writeln!(
             self.series_csv,
@@ -231,6 +255,15 @@ impl RunOutput {
             self.walls.add(world.time, w)?;
         }
         Ok(())
+    }
+
+    /// Writes the analyses' files that cover the whole run (the drum's); call once,
+    /// after the last `record`.
+    pub fn finish(&mut self, world: &World) -> io::Result<Option<DrumSummary>> {
+        match &mut self.drum {
+            Some(d) => d.finish(&self.dir, world).map(Some),
+            None => Ok(None),
+        }
     }
 
     /// Writes `summary.json`.

@@ -218,6 +218,7 @@ impl<'a> Builder<'a> {
                 count,
                 random_orientation: random,
                 velocity,
+                inside,
             } => {
                 let t = self.body_type(&path, shape, material)?;
                 finite(path.key("min"), min)?;
@@ -245,6 +246,10 @@ impl<'a> Builder<'a> {
                         ),
                     ));
                 }
+                let keep = match inside {
+                    Some(c) => Some(self.cylinder_region(&path.key("inside"), c, r)?),
+                    None => None,
+                };
                 let limit = count.unwrap_or(usize::MAX);
                 let mut placed = 0;
                 'fill: for z in 0..n[2] {
@@ -258,6 +263,9 @@ impl<'a> Builder<'a> {
                                 min[1] + r + a * y as Real,
                                 min[2] + r + a * z as Real,
                             );
+                            if keep.as_ref().is_some_and(|k| !k.contains(&pos)) {
+                                continue;
+                            }
                             let q = if *random {
                                 random_orientation(rng)
                             } else {
@@ -338,6 +346,52 @@ impl<'a> Builder<'a> {
         Ok(())
     }
 
+    fn cylinder_region(
+        &self,
+        path: &FieldPath,
+        c: &CylinderRegionSpec,
+        particle_radius: Real,
+    ) -> Result<CylinderRegion> {
+        finite(path.key("centre"), &c.centre)?;
+        finite(path.key("axis"), &c.axis)?;
+        positive(path.key("radius"), c.radius)?;
+        let axis = Vector3::from(c.axis);
+        if !(axis.norm() > 0.0) {
+            return Err(FieldError::new(
+                path.key("axis"),
+                "must be a non-zero vector",
+            ));
+        }
+        if !(c.fill > 0.0 && c.fill <= 1.0) {
+            return Err(FieldError::new(
+                path.key("fill"),
+                format!("{} is not in (0, 1]", c.fill),
+            ));
+        }
+        let axis = axis.normalize();
+        // "Down" is gravity across the axis; without gravity, any fill below 1 has no
+        // bottom to start from.
+        let g = self.world.gravity - axis * axis.dot(&self.world.gravity);
+        if c.fill < 1.0 && !(g.norm() > 0.0) {
+            return Err(FieldError::new(
+                path.key("fill"),
+                "needs gravity across the cylinder's axis to tell its bottom",
+            ));
+        }
+        Ok(CylinderRegion {
+            centre: Point3::from(c.centre),
+            axis,
+            inner: c.radius - particle_radius,
+            down: if g.norm() > 0.0 {
+                g.normalize()
+            } else {
+                Vector3::zeros()
+            },
+            // Height of the fill line above the centre, from the segment's area.
+            level: c.radius * segment_level(c.fill),
+        })
+    }
+
     fn push(
         &mut self,
         t: u32,
@@ -399,6 +453,29 @@ impl<'a> Builder<'a> {
         let surface = self.surface(&gpath, &w.geometry)?;
         if surface.triangles.is_empty() {
             return Err(FieldError::new(gpath, "the wall has no facets"));
+        }
+        if let MotionSpec::Attached { to } = &w.motion {
+            let mpath = path.key("motion").key("to");
+            let Some(k) = self.world.walls.iter().position(|l| &l.name == to) else {
+                return Err(FieldError::new(
+                    mpath,
+                    format!("no wall named '{to}' is listed before this one"),
+                ));
+            };
+            if w.reference.is_some() {
+                return Err(FieldError::new(
+                    path.key("reference"),
+                    "an attached wall shares its leader's reference point",
+                ));
+            }
+            let leader = &self.world.walls[k];
+            let mut wall = Wall::new(&w.name, material, surface.vertices, surface.triangles, cell)
+                .with_reference(leader.reference());
+            wall.motion = WallMotion::Attached(k);
+            wall.pose = leader.pose;
+            wall.velocity = leader.velocity;
+            wall.angular_velocity = leader.angular_velocity;
+            return Ok(wall);
         }
         let (motion, pivot) = motion(&path.key("motion"), &w.motion)?;
         let reference = match (w.reference, pivot) {
@@ -491,6 +568,43 @@ impl<'a> Builder<'a> {
     }
 }
 
+/// The sites a lattice keeps inside a cylinder.
+struct CylinderRegion {
+    centre: Point3<Real>,
+    axis: Vector3<Real>,
+    /// Largest distance of a particle centre from the axis.
+    inner: Real,
+    /// Unit vector of gravity across the axis.
+    down: Vector3<Real>,
+    /// Height of the fill line above the axis (against `down`).
+    level: Real,
+}
+
+impl CylinderRegion {
+    fn contains(&self, x: &Point3<Real>) -> bool {
+        let d = x - self.centre;
+        let radial = d - self.axis * self.axis.dot(&d);
+        radial.norm() <= self.inner && -radial.dot(&self.down) <= self.level
+    }
+}
+
+/// The height `y/R` of the chord below which a circle of unit radius holds the area
+/// fraction `fill`: solves `(θ − sin θ)/2π = fill` for the central angle θ by
+/// bisection (monotonic), then `y = −cos(θ/2)`.
+fn segment_level(fill: Real) -> Real {
+    let (mut lo, mut hi) = (0.0, std::f64::consts::TAU);
+    for _ in 0..100 {
+        let mid = 0.5 * (lo + hi);
+        if (mid - mid.sin()) / std::f64::consts::TAU < fill {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    let theta = 0.5 * (lo + hi);
+    -(0.5 * theta).cos()
+}
+
 /// The wall motion of a spec, and the point a rotation turns about.
 fn motion(path: &FieldPath, m: &MotionSpec) -> Result<(WallMotion, Option<Point3<Real>>)> {
     Ok(match m {
@@ -574,5 +688,6 @@ fn motion(path: &FieldPath, m: &MotionSpec) -> Result<(WallMotion, Option<Point3
             (WallMotion::Table(keys.clone()), None)
         }
         MotionSpec::External { input } => (WallMotion::External(*input), None),
+        MotionSpec::Attached { .. } => unreachable!("attached walls are built by Builder::wall"),
     })
 }

@@ -8,6 +8,7 @@
 //! [`spec`] for every field.
 
 mod build;
+mod drum;
 mod error;
 mod locate;
 mod plan;
@@ -25,6 +26,7 @@ pub use spec::SceneSpec;
 pub use state::{StateError, StateReader, StateWriter};
 
 use crate::Real;
+use crate::analysis::Drum;
 use crate::engine::time_step::{TimeStepEstimate, suggested_time_step};
 use crate::world::{Inlet, World};
 
@@ -49,6 +51,8 @@ pub struct Scene {
     pub warnings: Vec<String>,
     /// What will be computed, and why.
     pub plan: Plan,
+    /// The rotating drum the scene analyses, if any.
+    pub drum: Option<Drum>,
 }
 
 impl Scene {
@@ -149,6 +153,10 @@ impl Scene {
                 "max_speed and kinetic_energy_per_particle must be positive, hold non-negative",
             ));
         }
+        let drum = match &spec.drum {
+            Some(d) => Some(drum::resolve(d, &built.world)?),
+            None => None,
+        };
         let plan = Plan::new(&built.world, &built.inlets, dt, &suggested, &spec);
         Ok(Scene {
             file: path.to_path_buf(),
@@ -160,6 +168,7 @@ impl Scene {
             suggested,
             warnings,
             plan,
+            drum,
         })
     }
 

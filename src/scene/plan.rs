@@ -144,6 +144,7 @@ impl Plan {
                 WallMotion::External(DriveInput::Pose) => {
                     "driven from outside (pose inputs)".into()
                 }
+                WallMotion::Attached(k) => format!("moves with '{}'", world.walls[*k].name),
             };
             line(
                 format!("wall '{}': {} facets", w.name, w.triangles.len()),

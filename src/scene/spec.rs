@@ -39,6 +39,32 @@ pub struct SceneSpec {
     /// Particle sources.
     #[serde(default, rename = "inlet")]
     pub inlets: Vec<InletSpec>,
+    /// Rotating-drum analysis.
+    pub drum: Option<DrumSpec>,
+}
+
+/// `[drum]`: the walls that form a rotating drum, and how its bed is analysed
+/// (see [`crate::analysis::drum`]).
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct DrumSpec {
+    /// The walls that turn together; the first one's reference point is on the axis.
+    pub walls: Vec<String>,
+    /// Axis direction at the start.
+    pub axis: [Real; 3],
+    /// Thickness of the central slice analysed (default: the whole drum).
+    pub slice: Option<Real>,
+    /// Velocity-field cell edge (default: the largest circumscribed diameter).
+    pub cell: Option<Real>,
+    /// Time between samples of the surface and the field, s.
+    #[serde(default = "default_sample_interval")]
+    pub sample_interval: Real,
+    /// Start of the averages, s (default: when the first revolution is complete).
+    pub average_after: Option<Real>,
+}
+
+fn default_sample_interval() -> Real {
+    0.01
 }
 
 /// `[simulation]`.
@@ -339,6 +365,12 @@ pub enum MotionSpec {
         #[serde(default)]
         input: DriveInput,
     },
+    /// Moves rigidly with another wall listed before this one, about the same
+    /// reference point (the end caps of a drum); reported separately.
+    Attached {
+        /// Name of the wall it moves with.
+        to: String,
+    },
 }
 
 /// `[[particles]]`: particles present at the start.
@@ -365,6 +397,8 @@ pub enum ParticleGroupSpec {
         /// Initial velocity.
         #[serde(default)]
         velocity: [Real; 3],
+        /// Keep only sites inside this cylinder (a drum's fill).
+        inside: Option<CylinderRegionSpec>,
     },
     /// Particles listed one by one.
     List {
@@ -385,6 +419,25 @@ pub enum ParticleGroupSpec {
         /// Path relative to the scene file.
         file: PathBuf,
     },
+}
+
+/// A cylindrical region for lattice sites: a particle is kept if its bounding sphere
+/// lies inside the cylinder and its centre lies in the lowest `fill` of the
+/// cross-section (measured along gravity).
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct CylinderRegionSpec {
+    /// A point on the axis.
+    pub centre: [Real; 3],
+    /// Axis direction.
+    pub axis: [Real; 3],
+    /// Radius.
+    pub radius: Real,
+    /// Fraction of the cross-section's area, from its lowest point upwards, that the
+    /// sites fill (default 1). The lattice is looser than a settled bed, so the bed
+    /// settles lower.
+    #[serde(default = "one")]
+    pub fill: Real,
 }
 
 fn yes() -> bool {

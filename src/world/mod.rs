@@ -128,6 +128,24 @@ impl World {
             .fold(0.0, Real::max)
     }
 
+    /// Gives every attached wall its leader's pose and velocities (after the leaders
+    /// moved, or were set from outside). Leaders come before the walls attached to
+    /// them, so one pass in order also serves chains.
+    pub fn follow_leaders(&mut self) {
+        for k in 0..self.walls.len() {
+            if let Some(l) = self.walls[k].motion.leader() {
+                let (pose, v, w) = {
+                    let leader = &self.walls[l];
+                    (leader.pose, leader.velocity, leader.angular_velocity)
+                };
+                let wall = &mut self.walls[k];
+                wall.pose = pose;
+                wall.velocity = v;
+                wall.angular_velocity = w;
+            }
+        }
+    }
+
     /// Total kinetic energy (translation and rotation).
     pub fn kinetic_energy(&self) -> Real {
         let p = &self.particles;

@@ -50,6 +50,10 @@ pub enum WallMotion {
     Table(Vec<MotionKey>),
     /// Set from outside (co-simulation inputs); the velocities stay as last set.
     External(DriveInput),
+    /// Moves rigidly with the wall of this index (listed earlier in the world), sharing
+    /// its reference point: the end caps of a drum, the two halves of a mould. The
+    /// leader's pose and velocities are copied by [`crate::world::World::follow_leaders`].
+    Attached(usize),
 }
 
 /// What a co-simulation master gives for a wall driven from outside.
@@ -101,7 +105,15 @@ impl WallMotion {
                 })
             }
             WallMotion::Table(keys) => Some(interpolate(keys, t)),
-            WallMotion::External(_) => None,
+            WallMotion::External(_) | WallMotion::Attached(_) => None,
+        }
+    }
+
+    /// The wall this one is attached to.
+    pub fn leader(&self) -> Option<usize> {
+        match self {
+            WallMotion::Attached(k) => Some(*k),
+            _ => None,
         }
     }
 }

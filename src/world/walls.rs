@@ -102,7 +102,7 @@ impl Wall {
     /// Moves the wall from time `t` to `t + dt`: the pose by the velocities at the
     /// middle of the step, and the velocities to their values at the end.
     pub fn advance(&mut self, t: Real, dt: Real) {
-        if self.motion.is_fixed() {
+        if self.motion.is_fixed() || self.motion.leader().is_some() {
             return;
         }
         let mid = self.motion.velocity(t + 0.5 * dt).unwrap_or(WallVelocity {

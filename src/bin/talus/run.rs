@@ -77,9 +77,10 @@ fn run_loop(
         &sim.world,
         scene.spec.output.frame_interval,
         scene.spec.output.csv_interval,
+        scene.drum.as_ref(),
     )
     .with_context(|| format!("cannot write to {}", dir.display()))?;
-    out.record(&sim.world, scene.dt, sim.engine.contacts, true)?;
+    out.record(&sim.world, 0.0, sim.engine.contacts, true)?;
     let total_steps = (sim.end_time / scene.dt).ceil() as u64;
     let bar = if quiet {
         ProgressBar::hidden()
@@ -107,14 +108,13 @@ fn run_loop(
         // Land on the end time exactly.
         let remaining = sim.end_time - sim.time();
         let dt = scene.dt;
-        if remaining < dt {
-            sim.engine.dt = remaining;
-        }
+        let taken = dt.min(remaining);
+        sim.engine.dt = taken;
         particle_steps += sim.world.particles.len() as u64;
         sim.step();
         sim.engine.dt = dt;
         contact_sum += sim.engine.contacts as u64;
-        out.record(&sim.world, dt, sim.engine.contacts, false)?;
+        out.record(&sim.world, taken, sim.engine.contacts, false)?;
         if last_draw.elapsed() > Duration::from_millis(200) {
             last_draw = Instant::now();
             bar.set_position(sim.steps);
@@ -127,7 +127,8 @@ fn run_loop(
         }
     };
     bar.finish_and_clear();
-    out.record(&sim.world, scene.dt, sim.engine.contacts, true)?;
+    out.record(&sim.world, 0.0, sim.engine.contacts, true)?;
+    let drum = out.finish(&sim.world)?;
     let elapsed = started.elapsed().as_secs_f64();
     let report = sim.report();
     let summary = Summary {
@@ -156,6 +157,7 @@ fn run_loop(
             })
             .collect(),
         threads,
+        drum,
     };
     out.write_summary(&summary)?;
     println!(

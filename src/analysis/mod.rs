@@ -1,0 +1,13 @@
+//! Figures computed from a running simulation for a use case: the rotating drum
+//! (drive torque and power, angle of repose, velocity field, flowing layer).
+//!
+//! This layer reads the [`crate::world`] and keeps its own accumulators; it never
+//! changes the simulation. [`crate::output`] writes what it computes.
+
+pub mod drum;
+pub mod field;
+pub mod surface;
+
+pub use drum::{Drum, DrumMonitor, DrumRow, DrumSummary, Revolution};
+pub use field::VelocityField;
+pub use surface::{SurfaceFit, fit_surface};

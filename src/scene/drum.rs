@@ -1,0 +1,111 @@
+//! Resolves a scene's `[drum]` section against the built world.
+
+use nalgebra::{Point3, Vector3};
+
+use super::error::{FieldError, FieldPath};
+use super::spec::DrumSpec;
+use crate::Real;
+use crate::analysis::Drum;
+use crate::world::World;
+
+/// The drum of `spec`: wall names to indices, the axis and the drum's extent from
+/// the walls' vertices, the defaults that depend on the particles.
+pub(super) fn resolve(spec: &DrumSpec, world: &World) -> Result<Drum, FieldError> {
+    let path = FieldPath::root("drum");
+    if spec.walls.is_empty() {
+        return Err(FieldError::new(path.key("walls"), "name at least one wall"));
+    }
+    let mut walls = Vec::new();
+    for (k, name) in spec.walls.iter().enumerate() {
+        let Some(w) = world.walls.iter().position(|w| &w.name == name) else {
+            return Err(FieldError::new(
+                path.key("walls").index(k),
+                format!("no wall named '{name}'"),
+            ));
+        };
+        if walls.contains(&w) {
+            return Err(FieldError::new(
+                path.key("walls").index(k),
+                format!("wall '{name}' is named twice"),
+            ));
+        }
+        walls.push(w);
+    }
+    let axis = Vector3::from(spec.axis);
+    if !(axis.norm() > 0.0 && axis.iter().all(|x| x.is_finite())) {
+        return Err(FieldError::new(
+            path.key("axis"),
+            "must be a non-zero vector",
+        ));
+    }
+    let axis = axis.normalize();
+    let first = &world.walls[walls[0]];
+    let origin = first.reference();
+    // Extent of the walls about the axis through the first wall's reference point.
+    let (mut radius, mut lo, mut hi) = (0.0 as Real, Real::INFINITY, Real::NEG_INFINITY);
+    for &w in &walls {
+        let wall = &world.walls[w];
+        for v in &wall.vertices {
+            let d = wall.pose * v - origin;
+            let along = d.dot(&axis);
+            radius = radius.max((d - axis * along).norm());
+            lo = lo.min(along);
+            hi = hi.max(along);
+        }
+    }
+    let length = hi - lo;
+    if !(radius > 0.0) {
+        return Err(FieldError::new(
+            path.key("walls"),
+            "the walls do not surround the axis (no vertex off the axis)",
+        ));
+    }
+    let diameter = world
+        .body_types
+        .iter()
+        .map(|t| 2.0 * t.shape.circumradius())
+        .fold(0.0, Real::max);
+    if !(diameter > 0.0) {
+        return Err(FieldError::new(
+            path.clone(),
+            "the scene has no particle kinds",
+        ));
+    }
+    let positive = |name: &str, v: Option<Real>| -> Result<(), FieldError> {
+        match v {
+            Some(x) if !(x > 0.0 && x.is_finite()) => Err(FieldError::new(
+                path.key(name),
+                format!("{x} must be positive"),
+            )),
+            _ => Ok(()),
+        }
+    };
+    positive("slice", spec.slice)?;
+    positive("cell", spec.cell)?;
+    positive("sample_interval", Some(spec.sample_interval))?;
+    if let Some(t) = spec.average_after
+        && !(t >= 0.0 && t.is_finite())
+    {
+        return Err(FieldError::new(
+            path.key("average_after"),
+            format!("{t} must be a non-negative time"),
+        ));
+    }
+    let centre = origin + axis * (0.5 * (lo + hi));
+    let inverse = first.pose.inverse();
+    Ok(Drum {
+        walls,
+        axis_local: inverse * axis,
+        centre_local: inverse * Point3::from(centre.coords),
+        radius,
+        length,
+        slice: spec
+            .slice
+            .unwrap_or(length)
+            .min(length.max(Real::MIN_POSITIVE)),
+        cell: spec.cell.unwrap_or(diameter),
+        diameter,
+        sample_interval: spec.sample_interval,
+        average_after: spec.average_after,
+    })
+}
