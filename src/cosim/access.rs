@@ -135,6 +135,11 @@ impl Component {
                 (Some(s), Some(d)) => d.surface(&s.world).map_or(0.0, |f| f.slope.atan().abs()),
                 _ => 0.0,
             },
+            Role::BedHeight | Role::BedPorosity => match (sim, &self.scene.bed) {
+                (Some(s), Some(bed)) => crate::analysis::packing::bed_figures(&s.world, bed)
+                    .map_or(0.0, |(h, e)| if role == Role::BedHeight { h } else { e }),
+                _ => 0.0,
+            },
             Role::Scene | Role::OutputDir | Role::Threads | Role::Particles | Role::Contacts => {
                 unreachable!("not a real variable")
             }

@@ -95,6 +95,10 @@ pub enum Role {
     DrivePower,
     /// Output: dynamic angle of repose of the drum's bed at the end of the step.
     AngleOfRepose,
+    /// Output: height of the packed bed at the end of the step.
+    BedHeight,
+    /// Output: bed-averaged porosity at the end of the step.
+    BedPorosity,
 }
 
 /// One variable.
@@ -307,6 +311,23 @@ pub fn variable_table(scene: &Scene) -> Vec<Variable> {
                 .about(
                     "Inclination of the bed's free surface in the drum's central slice at the \
                      end of the step (0 when no surface is found)",
+                ),
+        ]);
+    }
+    if scene.bed.is_some() {
+        v.extend([
+            Variable::new("bed_height".into(), Role::BedHeight, Output, 1)
+                .unit("m")
+                .about(
+                    "Height of the packed bed above the tube's base at the end of the step \
+                     (where the slice solid fraction falls below half its median)",
+                ),
+            Variable::new("porosity".into(), Role::BedPorosity, Output, 1)
+                .unit("1")
+                .about(
+                    "Bed-averaged porosity at the end of the step, from the exact clipped \
+                     particle volumes, leaving out the layers at the base and the top \
+                     (0 while the bed is too low to leave a region)",
                 ),
         ]);
     }

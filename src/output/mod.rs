@@ -13,6 +13,7 @@
 //! - with a `[drum]` section, the drum's files (see [`drum`]).
 
 pub mod drum;
+pub mod packing;
 pub mod png;
 pub mod vtk;
 

@@ -23,6 +23,8 @@ pub(super) struct Built {
     pub world: World,
     pub inlets: Vec<Inlet>,
     pub next_id: u64,
+    /// The shape name of each body type.
+    pub shape_names: Vec<String>,
 }
 
 fn finite(path: FieldPath, values: &[Real]) -> Result<()> {
@@ -115,8 +117,14 @@ impl<'a> Builder<'a> {
             let wall = self.wall(&path, w, cell)?;
             self.world.walls.push(wall);
         }
+        let names: Vec<&String> = self.spec.shapes.keys().collect();
+        let mut shape_names = vec![String::new(); self.world.body_types.len()];
+        for (&(shape, _), &t) in &self.body_types {
+            shape_names[t as usize] = names[shape].clone();
+        }
         Ok(Built {
             world: self.world,
+            shape_names,
             inlets,
             next_id,
         })

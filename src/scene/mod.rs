@@ -7,8 +7,8 @@
 //! malformed, a key unknown, or a value unusable. See `examples/*/` for scenes and
 //! [`spec`] for every field.
 
+mod analyses;
 mod build;
-mod drum;
 mod error;
 mod locate;
 mod plan;
@@ -27,6 +27,7 @@ pub use state::{StateError, StateReader, StateWriter};
 
 use crate::Real;
 use crate::analysis::Drum;
+use crate::analysis::packing::Bed;
 use crate::engine::time_step::{TimeStepEstimate, suggested_time_step};
 use crate::world::{Inlet, World};
 
@@ -53,6 +54,10 @@ pub struct Scene {
     pub plan: Plan,
     /// The rotating drum the scene analyses, if any.
     pub drum: Option<Drum>,
+    /// The packed bed the scene analyses, if any.
+    pub bed: Option<Bed>,
+    /// The shape name of each body type (kind) of the world.
+    pub shape_names: Vec<String>,
 }
 
 impl Scene {
@@ -154,7 +159,11 @@ impl Scene {
             ));
         }
         let drum = match &spec.drum {
-            Some(d) => Some(drum::resolve(d, &built.world)?),
+            Some(d) => Some(analyses::resolve_drum(d, &built.world)?),
+            None => None,
+        };
+        let bed = match &spec.bed {
+            Some(b) => Some(analyses::resolve_bed(b)?),
             None => None,
         };
         let plan = Plan::new(&built.world, &built.inlets, dt, &suggested, &spec);
@@ -169,6 +178,8 @@ impl Scene {
             warnings,
             plan,
             drum,
+            bed,
+            shape_names: built.shape_names,
         })
     }
 

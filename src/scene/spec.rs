@@ -41,6 +41,38 @@ pub struct SceneSpec {
     pub inlets: Vec<InletSpec>,
     /// Rotating-drum analysis.
     pub drum: Option<DrumSpec>,
+    /// Packed-bed analysis.
+    pub bed: Option<BedSpec>,
+}
+
+/// `[bed]`: the tube a bed is packed in, and how the packing is analysed (see
+/// [`crate::analysis::packing`]).
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct BedSpec {
+    /// Centre of the tube's base.
+    pub base: [Real; 3],
+    /// Tube axis, up the bed (default z).
+    #[serde(default = "up")]
+    pub axis: [Real; 3],
+    /// Inner radius of the tube.
+    pub radius: Real,
+    /// Radial bin width (default d/20, d the volume-equivalent diameter).
+    pub bin: Option<Real>,
+    /// Axial slice thickness (default d/10).
+    pub slice: Option<Real>,
+    /// Layer left out of the averages at the base and below the top (default 2 d).
+    pub exclude: Option<Real>,
+    /// Surfaces closer than this touch, for coordination (default d/1000).
+    pub gap: Option<Real>,
+    /// Each particle's size in `bed.stl`, relative to its own (default 1; below 1
+    /// separates touching particles for CFD meshing).
+    #[serde(default = "one")]
+    pub shrink: Real,
+}
+
+fn up() -> [Real; 3] {
+    [0.0, 0.0, 1.0]
 }
 
 /// `[drum]`: the walls that form a rotating drum, and how its bed is analysed

@@ -1,5 +1,6 @@
 //! The `talus` command line.
 
+mod analyze;
 mod bench;
 mod contact;
 mod fmu;
@@ -44,6 +45,12 @@ enum Command {
         /// No progress bar.
         #[arg(long)]
         quiet: bool,
+    },
+    /// Analyse the packed bed of a finished run (its scene's [bed] section, its
+    /// poses.csv): packing.json, porosity profiles, bed.stl.
+    Analyze {
+        /// The run's output directory.
+        dir: PathBuf,
     },
     /// Pack a scene as an FMI 2.0 or 3.0 Co-Simulation FMU.
     Fmu {
@@ -134,6 +141,7 @@ fn main() -> Result<()> {
             },
         ),
         Command::Contact { file } => contact::contact(&file),
+        Command::Analyze { dir } => analyze::analyze(&dir),
         #[cfg(feature = "zenoh")]
         Command::Serve {
             scene,

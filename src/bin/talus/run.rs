@@ -132,7 +132,11 @@ fn run_loop(
     let elapsed = started.elapsed().as_secs_f64();
     let report = sim.report();
     let summary = Summary {
-        scene: scene.file.display().to_string(),
+        // Absolute, so that `talus analyze` finds it from anywhere.
+        scene: std::fs::canonicalize(&scene.file)
+            .unwrap_or_else(|_| scene.file.clone())
+            .display()
+            .to_string(),
         ended_by: ended_by.into(),
         time: report.time,
         dt: scene.dt,
@@ -160,6 +164,9 @@ fn run_loop(
         drum,
     };
     out.write_summary(&summary)?;
+    if let Some(bed) = &scene.bed {
+        crate::analyze::write_bed_files(scene, bed, &sim.world, dir)?;
+    }
     println!(
         "{}: {} at t = {:.6e} s after {} steps in {:.2} s ({:.3e} particle-steps/s, {:.3e} contacts/s); {} particles; output in {}",
         scene.file.display(),

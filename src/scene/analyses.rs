@@ -1,16 +1,17 @@
-//! Resolves a scene's `[drum]` section against the built world.
+//! Resolves a scene's `[drum]` and `[bed]` sections against the built world.
 
 use nalgebra::{Point3, Vector3};
 
 use super::error::{FieldError, FieldPath};
-use super::spec::DrumSpec;
+use super::spec::{BedSpec, DrumSpec};
 use crate::Real;
 use crate::analysis::Drum;
+use crate::analysis::packing::{Bed, PackingOptions, Tube};
 use crate::world::World;
 
 /// The drum of `spec`: wall names to indices, the axis and the drum's extent from
 /// the walls' vertices, the defaults that depend on the particles.
-pub(super) fn resolve(spec: &DrumSpec, world: &World) -> Result<Drum, FieldError> {
+pub(super) fn resolve_drum(spec: &DrumSpec, world: &World) -> Result<Drum, FieldError> {
     let path = FieldPath::root("drum");
     if spec.walls.is_empty() {
         return Err(FieldError::new(path.key("walls"), "name at least one wall"));
@@ -107,5 +108,63 @@ pub(super) fn resolve(spec: &DrumSpec, world: &World) -> Result<Drum, FieldError
         diameter,
         sample_interval: spec.sample_interval,
         average_after: spec.average_after,
+    })
+}
+
+/// The bed of `spec`, every length checked.
+pub(super) fn resolve_bed(spec: &BedSpec) -> Result<Bed, FieldError> {
+    let path = FieldPath::root("bed");
+    if !spec.base.iter().all(|x| x.is_finite()) {
+        return Err(FieldError::new(path.key("base"), "must be finite"));
+    }
+    let axis = Vector3::from(spec.axis);
+    if !(axis.norm() > 0.0 && axis.iter().all(|x| x.is_finite())) {
+        return Err(FieldError::new(
+            path.key("axis"),
+            "must be a non-zero vector",
+        ));
+    }
+    for (name, v) in [
+        ("radius", Some(spec.radius)),
+        ("bin", spec.bin),
+        ("slice", spec.slice),
+        ("gap", spec.gap),
+    ] {
+        if let Some(x) = v
+            && !(x > 0.0 && x.is_finite())
+        {
+            return Err(FieldError::new(
+                path.key(name),
+                format!("{x} must be positive"),
+            ));
+        }
+    }
+    if let Some(x) = spec.exclude
+        && !(x >= 0.0 && x.is_finite())
+    {
+        return Err(FieldError::new(
+            path.key("exclude"),
+            format!("{x} must be non-negative"),
+        ));
+    }
+    if !(spec.shrink > 0.0 && spec.shrink <= 1.0) {
+        return Err(FieldError::new(
+            path.key("shrink"),
+            format!("{} is not in (0, 1]", spec.shrink),
+        ));
+    }
+    Ok(Bed {
+        tube: Tube {
+            base: Point3::from(spec.base),
+            axis: axis.normalize(),
+            radius: spec.radius,
+        },
+        options: PackingOptions {
+            bin: spec.bin,
+            slice: spec.slice,
+            exclude: spec.exclude,
+            gap: spec.gap,
+            region: None,
+        },
     })
 }

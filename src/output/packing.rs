@@ -1,0 +1,174 @@
+//! A packed bed's files:
+//!
+//! - `packing.json`: the figures of [`crate::analysis::packing::Packing`] (bed
+//!   height, region, bed-averaged porosity with the quadrature's error estimate,
+//!   coordination and orientation distributions, both profiles);
+//! - `packing_radial.csv` (`r_inner,r_outer,porosity`) and `packing_axial.csv`
+//!   (`z_lower,z_upper,porosity`, heights above the tube's base);
+//! - `poses.csv`: `id,kind,shape,x,y,z,qw,qx,qy,qz` per particle (the body frame's
+//!   pose: centroid and principal axes), which `talus analyze` reads back;
+//! - `bed.stl`: every particle's surface in place (spheres as 320-triangle
+//!   icospheres), each scaled about its centroid by the scene's `shrink`.
+
+use std::fs::File;
+use std::io::{self, BufWriter, Write};
+use std::path::Path;
+
+use nalgebra::{Point3, UnitQuaternion};
+
+use crate::Real;
+use crate::analysis::packing::Packing;
+use crate::geometry::Shape;
+use crate::geometry::generators::icosphere_mesh;
+use crate::geometry::mesh_io::write_stl;
+use crate::world::World;
+
+/// Writes `packing.json` and the two profile CSVs.
+pub fn write_packing(dir: &Path, packing: &Packing) -> io::Result<()> {
+    let text = serde_json::to_string_pretty(packing).map_err(io::Error::other)?;
+    std::fs::write(dir.join("packing.json"), text + "\n")?;
+    let mut radial = BufWriter::new(File::create(dir.join("packing_radial.csv"))?);
+    writeln!(radial, "r_inner,r_outer,porosity")?;
+    for b in &packing.radial {
+        writeln!(
+            radial,
+            "{:.9e},{:.9e},{:.9e}",
+            b.r_inner, b.r_outer, b.porosity
+        )?;
+    }
+    radial.flush()?;
+    let mut axial = BufWriter::new(File::create(dir.join("packing_axial.csv"))?);
+    writeln!(axial, "z_lower,z_upper,porosity")?;
+    for s in &packing.axial {
+        writeln!(
+            axial,
+            "{:.9e},{:.9e},{:.9e}",
+            s.z_lower, s.z_upper, s.porosity
+        )?;
+    }
+    axial.flush()
+}
+
+/// Writes `poses.csv`; `shape_names[k]` names body type `k`.
+pub fn write_poses(dir: &Path, world: &World, shape_names: &[String]) -> io::Result<()> {
+    let mut out = BufWriter::new(File::create(dir.join("poses.csv"))?);
+    writeln!(out, "id,kind,shape,x,y,z,qw,qx,qy,qz")?;
+    let p = &world.particles;
+    for i in 0..p.len() {
+        let (x, q) = (p.position[i], p.orientation[i]);
+        let kind = p.body_type[i] as usize;
+        writeln!(
+            out,
+            // Shortest round-trip forms: `talus analyze` reads back the same bits.
+            "{},{kind},{},{:e},{:e},{:e},{:e},{:e},{:e},{:e}",
+            p.id[i],
+            shape_names.get(kind).map_or("", String::as_str),
+            x.x,
+            x.y,
+            x.z,
+            q.w,
+            q.i,
+            q.j,
+            q.k
+        )?;
+    }
+    out.flush()
+}
+
+/// Reads `poses.csv` back into `world` (replacing its particles), each row's kind
+/// checked against the world's body types.
+pub fn read_poses(path: &Path, world: &mut World) -> Result<(), String> {
+    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let mut lines = text.lines().enumerate();
+    match lines.next() {
+        Some((_, h)) if h.trim() == "id,kind,shape,x,y,z,qw,qx,qy,qz" => {}
+        _ => {
+            return Err(format!(
+                "{}:1: the header must be id,kind,shape,x,y,z,qw,qx,qy,qz",
+                path.display()
+            ));
+        }
+    }
+    world.particles = Default::default();
+    for (n, line) in lines {
+        if line.trim().is_empty() {
+            continue;
+        }
+        let at = |what: &str| format!("{}:{}: {what}", path.display(), n + 1);
+        let f: Vec<&str> = line.split(',').collect();
+        if f.len() != 10 {
+            return Err(at(&format!("{} fields, expected 10", f.len())));
+        }
+        let id: u64 = f[0]
+            .trim()
+            .parse()
+            .map_err(|_| at("id is not an integer"))?;
+        let kind: u32 = f[1]
+            .trim()
+            .parse()
+            .map_err(|_| at("kind is not an integer"))?;
+        if kind as usize >= world.body_types.len() {
+            return Err(at(&format!(
+                "kind {kind}, but the scene has {} particle kinds",
+                world.body_types.len()
+            )));
+        }
+        let mut v = [0.0; 7];
+        for (k, x) in v.iter_mut().enumerate() {
+            *x = f[3 + k]
+                .trim()
+                .parse::<Real>()
+                .ok()
+                .filter(|x| x.is_finite())
+                .ok_or_else(|| at(&format!("field {} is not a finite number", 4 + k)))?;
+        }
+        let q = nalgebra::Quaternion::new(v[3], v[4], v[5], v[6]);
+        if !(q.norm() > 0.5) {
+            return Err(at("the quaternion is not a rotation"));
+        }
+        // A unit quaternion as written is kept bit for bit; others are normalised.
+        let q = if (q.norm() - 1.0).abs() < 1e-12 {
+            UnitQuaternion::new_unchecked(q)
+        } else {
+            UnitQuaternion::from_quaternion(q)
+        };
+        world
+            .particles
+            .push(kind, Point3::new(v[0], v[1], v[2]), q, id);
+    }
+    Ok(())
+}
+
+/// Writes `bed.stl`: every particle's surface in place, scaled by `shrink` about
+/// its centroid.
+pub fn write_bed_stl(dir: &Path, world: &World, shrink: Real) -> io::Result<()> {
+    let p = &world.particles;
+    let mut vertices = Vec::new();
+    let mut triangles = Vec::new();
+    let mut balls = std::collections::HashMap::new();
+    for i in 0..p.len() {
+        let t = &world.body_types[p.body_type[i] as usize];
+        let (local, tris): (Vec<Point3<Real>>, Vec<[usize; 3]>) = match &t.shape {
+            Shape::Polyhedron(poly) => (
+                poly.vertices().to_vec(),
+                poly.triangles()
+                    .iter()
+                    .map(|t| t.map(|v| v as usize))
+                    .collect(),
+            ),
+            Shape::Sphere(s) => balls
+                .entry(s.radius.to_bits())
+                .or_insert_with(|| {
+                    let mesh = icosphere_mesh(2, s.radius).expect("a positive radius");
+                    (mesh.vertices, mesh.triangles)
+                })
+                .clone(),
+        };
+        let base = vertices.len();
+        for v in &local {
+            vertices.push(p.position[i] + p.orientation[i] * (v.coords * shrink));
+        }
+        triangles.extend(tris.iter().map(|t| t.map(|v| v + base)));
+    }
+    write_stl(&dir.join("bed.stl"), &vertices, &triangles)
+}
