@@ -180,7 +180,7 @@ pub struct DrumRow {
 pub struct Revolution {
     /// Revolution number, from 1.
     pub number: usize,
-    /// Start and end time, s.
+    /// Start time, s.
     pub start: Real,
     /// End time, s.
     pub end: Real,
@@ -203,7 +203,7 @@ pub struct DrumSummary {
     pub average_from: Option<Real>,
     /// Length of the window, s.
     pub averaged_over: Real,
-    /// Mean angular speed, rad/s, and in rpm.
+    /// Mean angular speed (magnitude), rad/s.
     pub angular_speed: Real,
     /// Mean speed in revolutions per minute.
     pub rpm: Real,
@@ -219,8 +219,7 @@ pub struct DrumSummary {
     pub power: Real,
     /// Mean of minus the bed's gravitational moment, N m.
     pub gravity_moment: Real,
-    /// Dynamic angle of repose: mean over the samples, degrees, and its standard
-    /// deviation.
+    /// Dynamic angle of repose: mean over the samples, degrees.
     pub angle_of_repose: Option<Real>,
     /// Standard deviation of the sampled angles, degrees.
     pub angle_of_repose_std: Option<Real>,
@@ -233,7 +232,7 @@ pub struct DrumSummary {
     pub solids_fraction: Real,
     /// Samples taken in the window.
     pub samples: usize,
-    /// Drum radius, m, and the slice analysed, m.
+    /// Drum radius, m.
     pub radius: Real,
     /// Thickness of the central slice, m.
     pub slice: Real,

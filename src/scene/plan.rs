@@ -179,6 +179,18 @@ impl Plan {
                 None => "no particle kinds".into(),
             },
         );
+        if let Some(d) = &spec.drum {
+            line(
+                format!("drum analysis: walls {}", d.walls.join(", ")),
+                "drive torque, angle of repose, velocity field ([drum])".into(),
+            );
+        }
+        if let Some(b) = &spec.bed {
+            line(
+                format!("bed analysis: tube of radius {} m", b.radius),
+                "packing.json, profiles, poses.csv, bed.stl at the end ([bed])".into(),
+            );
+        }
         plan.friction = friction;
         plan.polyhedra = n_poly > 0;
         plan.moving_walls = moving > 0;
