@@ -27,26 +27,38 @@ use crate::world::World;
 pub fn write_packing(dir: &Path, packing: &Packing) -> io::Result<()> {
     let text = serde_json::to_string_pretty(packing).map_err(io::Error::other)?;
     std::fs::write(dir.join("packing.json"), text + "\n")?;
-    let mut radial = BufWriter::new(File::create(dir.join("packing_radial.csv"))?);
-    writeln!(radial, "r_inner,r_outer,porosity")?;
-    for b in &packing.radial {
-        writeln!(
-            radial,
-            "{:.9e},{:.9e},{:.9e}",
-            b.r_inner, b.r_outer, b.porosity
-        )?;
+    let radial = packing
+        .radial
+        .iter()
+        .map(|b| [b.r_inner, b.r_outer, b.porosity]);
+    write_profile(
+        &dir.join("packing_radial.csv"),
+        "r_inner,r_outer,porosity",
+        radial,
+    )?;
+    let axial = packing
+        .axial
+        .iter()
+        .map(|s| [s.z_lower, s.z_upper, s.porosity]);
+    write_profile(
+        &dir.join("packing_axial.csv"),
+        "z_lower,z_upper,porosity",
+        axial,
+    )
+}
+
+/// A profile as CSV: bin edges and porosity per row.
+fn write_profile(
+    path: &Path,
+    header: &str,
+    rows: impl Iterator<Item = [Real; 3]>,
+) -> io::Result<()> {
+    let mut out = BufWriter::new(File::create(path)?);
+    writeln!(out, "{header}")?;
+    for [a, b, e] in rows {
+        writeln!(out, "{a:.9e},{b:.9e},{e:.9e}")?;
     }
-    radial.flush()?;
-    let mut axial = BufWriter::new(File::create(dir.join("packing_axial.csv"))?);
-    writeln!(axial, "z_lower,z_upper,porosity")?;
-    for s in &packing.axial {
-        writeln!(
-            axial,
-            "{:.9e},{:.9e},{:.9e}",
-            s.z_lower, s.z_upper, s.porosity
-        )?;
-    }
-    axial.flush()
+    out.flush()
 }
 
 /// Writes `poses.csv`; `shape_names[k]` names body type `k`.
