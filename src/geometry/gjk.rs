@@ -108,6 +108,7 @@ pub fn gjk<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
 ) -> GjkResult {
     const MAX_ITERATIONS: usize = 128;
     const REL_TOLERANCE: Real = 1e-12;
+    const ABS_TOLERANCE: Real = 1e-13;
     let inv_rot = b_in_a.rotation.inverse();
     let (mut hint_a, mut hint_b) = (0usize, 0usize);
     let mut support = |d: &Vector3<Real>| {
@@ -139,8 +140,15 @@ pub fn gjk<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
         }
         let w = support(&-v);
         max_w2 = max_w2.max(w.w.norm_squared());
-        // Convergence: the support point brings v no closer.
-        if v2 - v.dot(&w.w) <= REL_TOLERANCE * v2 || simplex[..count].iter().any(|s| s.w == w.w) {
+        // Convergence: the support point brings v no closer than round-off can tell.
+        // v carries an absolute error of a few hundred ε·|w| from the simplex
+        // arithmetic, so v·w does too, times |v|; near contact (|v| ≪ |w|) the
+        // relative test alone would go on and add a point coplanar with the nearest
+        // face: a flat tetrahedron whose inside test is round-off.
+        let gap = v2 - v.dot(&w.w);
+        if gap <= REL_TOLERANCE * v2 + ABS_TOLERANCE * (v2 * max_w2).sqrt()
+            || simplex[..count].iter().any(|s| s.w == w.w)
+        {
             return separated(&simplex, &weights, v2);
         }
         simplex[count] = w;
@@ -260,7 +268,14 @@ fn closest_on_tetrahedron(s: &[Vertex]) -> (Vector3<Real>, SubSimplex) {
     let faces = [(0, 1, 2, 3), (0, 1, 3, 2), (0, 2, 3, 1), (1, 2, 3, 0)];
     let mut best: Option<(Vector3<Real>, SubSimplex)> = None;
     let mut best_d2 = Real::INFINITY;
-    let mut inside = true;
+    // A flat tetrahedron (a new support point in the plane of the nearest face, as
+    // near contact) has no inside that round-off can decide: take its faces.
+    let scale = (1..4)
+        .map(|k| (s[k].w - s[0].w).norm())
+        .fold(0.0, Real::max);
+    let volume = (s[1].w - s[0].w).dot(&(s[2].w - s[0].w).cross(&(s[3].w - s[0].w)));
+    let flat = volume.abs() <= 1e-9 * scale.powi(3);
+    let mut inside = !flat;
     for (i, j, k, l) in faces {
         let (a, b, c, d) = (s[i].w, s[j].w, s[k].w, s[l].w);
         let n = (b - a).cross(&(c - a));
@@ -268,7 +283,7 @@ fn closest_on_tetrahedron(s: &[Vertex]) -> (Vector3<Real>, SubSimplex) {
         let sign_other = n.dot(&(d - a));
         // Origin on the far side of this face from the fourth vertex (or on it for a
         // flat tetrahedron): the closest point lies on this face.
-        if sign_origin * sign_other < 0.0 || sign_other == 0.0 {
+        if flat || sign_origin * sign_other < 0.0 || sign_other == 0.0 {
             inside = false;
             let (p, sub) = closest_on_triangle(s, i, j, k);
             let d2 = p.norm_squared();
