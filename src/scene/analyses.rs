@@ -1,7 +1,8 @@
 //! Resolves a scene's `[drum]` and `[bed]` sections against the built world.
 
-use nalgebra::{Point3, Vector3};
+use nalgebra::Point3;
 
+use super::build::{direction, finite, positive};
 use super::error::{FieldError, FieldPath};
 use super::spec::{BedSpec, DrumSpec};
 use crate::Real;
@@ -32,14 +33,7 @@ pub(super) fn resolve_drum(spec: &DrumSpec, world: &World) -> Result<Drum, Field
         }
         walls.push(w);
     }
-    let axis = Vector3::from(spec.axis);
-    if !(axis.norm() > 0.0 && axis.iter().all(|x| x.is_finite())) {
-        return Err(FieldError::new(
-            path.key("axis"),
-            "must be a non-zero vector",
-        ));
-    }
-    let axis = axis.normalize();
+    let axis = direction(path.key("axis"), &spec.axis)?;
     let first = &world.walls[walls[0]];
     let origin = first.reference();
     // Extent of the walls about the axis through the first wall's reference point.
@@ -72,18 +66,15 @@ pub(super) fn resolve_drum(spec: &DrumSpec, world: &World) -> Result<Drum, Field
             "the scene has no particle kinds",
         ));
     }
-    let positive = |name: &str, v: Option<Real>| -> Result<(), FieldError> {
-        match v {
-            Some(x) if !(x > 0.0 && x.is_finite()) => Err(FieldError::new(
-                path.key(name),
-                format!("{x} must be positive"),
-            )),
-            _ => Ok(()),
+    for (name, v) in [
+        ("slice", spec.slice),
+        ("cell", spec.cell),
+        ("sample_interval", Some(spec.sample_interval)),
+    ] {
+        if let Some(x) = v {
+            positive(path.key(name), x)?;
         }
-    };
-    positive("slice", spec.slice)?;
-    positive("cell", spec.cell)?;
-    positive("sample_interval", Some(spec.sample_interval))?;
+    }
     if let Some(t) = spec.average_after
         && !(t >= 0.0 && t.is_finite())
     {
@@ -114,29 +105,16 @@ pub(super) fn resolve_drum(spec: &DrumSpec, world: &World) -> Result<Drum, Field
 /// The bed of `spec`, every length checked.
 pub(super) fn resolve_bed(spec: &BedSpec) -> Result<Bed, FieldError> {
     let path = FieldPath::root("bed");
-    if !spec.base.iter().all(|x| x.is_finite()) {
-        return Err(FieldError::new(path.key("base"), "must be finite"));
-    }
-    let axis = Vector3::from(spec.axis);
-    if !(axis.norm() > 0.0 && axis.iter().all(|x| x.is_finite())) {
-        return Err(FieldError::new(
-            path.key("axis"),
-            "must be a non-zero vector",
-        ));
-    }
+    finite(path.key("base"), &spec.base)?;
+    let axis = direction(path.key("axis"), &spec.axis)?;
     for (name, v) in [
         ("radius", Some(spec.radius)),
         ("bin", spec.bin),
         ("slice", spec.slice),
         ("gap", spec.gap),
     ] {
-        if let Some(x) = v
-            && !(x > 0.0 && x.is_finite())
-        {
-            return Err(FieldError::new(
-                path.key(name),
-                format!("{x} must be positive"),
-            ));
+        if let Some(x) = v {
+            positive(path.key(name), x)?;
         }
     }
     if let Some(x) = spec.exclude
@@ -156,7 +134,7 @@ pub(super) fn resolve_bed(spec: &BedSpec) -> Result<Bed, FieldError> {
     Ok(Bed {
         tube: Tube {
             base: Point3::from(spec.base),
-            axis: axis.normalize(),
+            axis,
             radius: spec.radius,
         },
         options: PackingOptions {

@@ -27,7 +27,7 @@ pub(super) struct Built {
     pub shape_names: Vec<String>,
 }
 
-fn finite(path: FieldPath, values: &[Real]) -> Result<()> {
+pub(super) fn finite(path: FieldPath, values: &[Real]) -> Result<()> {
     if values.iter().all(|v| v.is_finite()) {
         Ok(())
     } else {
@@ -35,11 +35,21 @@ fn finite(path: FieldPath, values: &[Real]) -> Result<()> {
     }
 }
 
-fn positive(path: FieldPath, value: Real) -> Result<()> {
+pub(super) fn positive(path: FieldPath, value: Real) -> Result<()> {
     if value.is_finite() && value > 0.0 {
         Ok(())
     } else {
         Err(FieldError::new(path, format!("{value} must be positive")))
+    }
+}
+
+/// The unit vector along `v`, which must be finite and non-zero.
+pub(super) fn direction(path: FieldPath, v: &[Real; 3]) -> Result<Vector3<Real>> {
+    let v = Vector3::from(*v);
+    if v.norm() > 0.0 && v.norm().is_finite() {
+        Ok(v.normalize())
+    } else {
+        Err(FieldError::new(path, "must be a non-zero vector"))
     }
 }
 
@@ -363,20 +373,13 @@ impl<'a> Builder<'a> {
         finite(path.key("centre"), &c.centre)?;
         finite(path.key("axis"), &c.axis)?;
         positive(path.key("radius"), c.radius)?;
-        let axis = Vector3::from(c.axis);
-        if !(axis.norm() > 0.0) {
-            return Err(FieldError::new(
-                path.key("axis"),
-                "must be a non-zero vector",
-            ));
-        }
+        let axis = direction(path.key("axis"), &c.axis)?;
         if !(c.fill > 0.0 && c.fill <= 1.0) {
             return Err(FieldError::new(
                 path.key("fill"),
                 format!("{} is not in (0, 1]", c.fill),
             ));
         }
-        let axis = axis.normalize();
         // "Down" is gravity across the axis; without gravity, any fill below 1 has no
         // bottom to start from.
         let g = self.world.gravity - axis * axis.dot(&self.world.gravity);
@@ -634,13 +637,7 @@ fn motion(path: &FieldPath, m: &MotionSpec) -> Result<(WallMotion, Option<Point3
             rate,
         } => {
             finite(path.key("point"), point)?;
-            let axis = Vector3::from(*axis);
-            if !(axis.norm() > 0.0 && axis.norm().is_finite()) {
-                return Err(FieldError::new(
-                    path.key("axis"),
-                    "must be a non-zero vector",
-                ));
-            }
+            let axis = direction(path.key("axis"), axis)?;
             let rate = match (rpm, rate) {
                 (Some(rpm), None) => rpm * std::f64::consts::TAU / 60.0,
                 (None, Some(r)) => *r,
@@ -658,7 +655,7 @@ fn motion(path: &FieldPath, m: &MotionSpec) -> Result<(WallMotion, Option<Point3
             (
                 WallMotion::Constant {
                     velocity: Vector3::zeros(),
-                    angular_velocity: axis.normalize() * rate,
+                    angular_velocity: axis * rate,
                 },
                 Some(Point3::from(*point)),
             )
