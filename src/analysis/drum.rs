@@ -72,17 +72,29 @@ impl Drum {
     /// axial torque the particles exert on each drum wall, and the power delivered,
     /// at this instant.
     pub fn torques(&self, world: &World) -> (Real, Vec<Real>, Real) {
-        let (axis, centre) = self.frame(world);
         let per_wall: Vec<Real> = self
             .walls
             .iter()
             .map(|&w| {
                 let wall = &world.walls[w];
-                (wall.torque + (wall.reference() - centre).cross(&wall.force)).dot(&axis)
+                self.axial_torque(world, w, &wall.force, &wall.torque)
             })
             .collect();
         let power = self.walls.iter().map(|&w| world.walls[w].power()).sum();
         (-per_wall.iter().sum::<Real>(), per_wall, power)
+    }
+
+    /// The axial component, about the axis point, of a force and a torque (about
+    /// its reference point) on wall `w`.
+    pub fn axial_torque(
+        &self,
+        world: &World,
+        w: usize,
+        force: &Vector3<Real>,
+        torque: &Vector3<Real>,
+    ) -> Real {
+        let (axis, centre) = self.frame(world);
+        (torque + (world.walls[w].reference() - centre).cross(force)).dot(&axis)
     }
 
     /// Minus the gravitational moment of the bed about the axis: what the drive

@@ -153,13 +153,11 @@ impl Component {
         let (Some(sim), Some(drum)) = (self.sim.as_ref(), &self.scene.drum) else {
             return (0.0, 0.0);
         };
-        let (axis, centre) = drum.frame(&sim.world);
         let mut torque = 0.0;
         let mut power = 0.0;
         for &w in &drum.walls {
             let m = &self.means[w];
-            let arm = sim.world.walls[w].reference() - centre;
-            torque -= (m.torque + arm.cross(&m.force)).dot(&axis);
+            torque -= drum.axial_torque(&sim.world, w, &m.force, &m.torque);
             power += m.power;
         }
         (torque, power)
