@@ -150,10 +150,12 @@ proptest! {
         let scale = o.area * 0.01;
         prop_assert!((rot_b - o.rotation_gradient_b).norm() <= 1e-4 * scale + 1e-14, "fd {rot_b} vs {}", o.rotation_gradient_b);
         prop_assert!((rot_a - o.rotation_gradient_a).norm() <= 1e-4 * scale + 1e-14, "fd {rot_a} vs {}", o.rotation_gradient_a);
-        // Angular momentum balance: the torques and the force's moment cancel.
+        // Angular momentum balance: the torques and the force's moment cancel. When B
+        // lies wholly inside A every term is zero up to the round-off of moments of
+        // 1 cm faces (each ~1e-6 m³, eps 2e-16): hence the absolute floor.
         let t = rel.translation.vector;
         let balance = o.rotation_gradient_a + o.rotation_gradient_b + t.cross(&expected);
-        prop_assert!(balance.norm() <= 1e-9 * scale, "{balance}");
+        prop_assert!(balance.norm() <= 1e-9 * scale + 1e-18, "{balance}");
     }
 }
 

@@ -65,7 +65,8 @@ pub fn normal_force(c: &NormalContact, damping: &DampingTable) -> NormalForce {
     let v0 = c.regularisation.max(0.0);
     let regular = volume < v0;
     let (elastic, energy) = if regular {
-        let scale = v0.powf(2.0 / 3.0);
+        // V₀^{2/3} (a cube root is several times cheaper than a power).
+        let scale = v0.cbrt().powi(2);
         (
             c.stiffness * c.area * volume / scale,
             0.5 * c.stiffness * volume * volume / scale,

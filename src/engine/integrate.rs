@@ -69,11 +69,26 @@ pub fn half_kick(state: &mut RotationState, torque: &Vector3<Real>, dt: Real) {
     state.angular_momentum += torque * (0.5 * dt);
 }
 
+/// Whether principal moments are equal to round-off: such a body (a sphere, a cube, a
+/// regular polyhedron) turns steadily about its angular momentum.
+#[inline]
+pub fn is_isotropic(inertia: &Vector3<Real>) -> bool {
+    inertia.max() - inertia.min() <= 1e-12 * inertia.max()
+}
+
 /// Torque-free rotation over `dt` (see the module docs).
 pub fn free_rotation(state: &mut RotationState, inertia: &Vector3<Real>, dt: Real) {
     let l0 = state
         .orientation
         .inverse_transform_vector(&state.angular_momentum);
+    if is_isotropic(inertia) {
+        // The midpoint rule's answer in closed form: L stays, and the body turns by
+        // the Cayley rotation of h ω / 2.
+        let w = l0 * (0.5 * dt / inertia.x);
+        let turn = UnitQuaternion::from_quaternion(Quaternion::new(1.0, w.x, w.y, w.z));
+        state.orientation = UnitQuaternion::new_normalize((state.orientation * turn).into_inner());
+        return;
+    }
     let inv_inertia = inertia.map(|i| 1.0 / i);
     let scale = l0.norm().max(Real::MIN_POSITIVE);
     let mut l1 = l0;

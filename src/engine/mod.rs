@@ -9,5 +9,6 @@
 
 pub mod broad_phase;
 pub mod integrate;
+pub mod neighbours;
 pub mod step;
 pub mod time_step;

@@ -8,8 +8,8 @@ use std::collections::HashMap;
 use nalgebra::{Matrix3, Point3, Vector3};
 use rayon::prelude::*;
 
-use super::broad_phase::BroadPhase;
 use super::integrate::{RotationState, free_rotation, half_kick};
+use super::neighbours::NeighbourList;
 use crate::Real;
 use crate::contact::{
     DampingTable, NormalContact, PairStiffness, TangentialHistory, normal_force, rocking_damping,
@@ -78,9 +78,16 @@ pub struct Engine {
     /// Length, relative to the smaller equivalent radius of a contact, below whose
     /// cube the volume law is regularised (see [`crate::contact::normal_force`]).
     pub regularisation_length: Real,
-    broad: BroadPhase,
-    pairs: Vec<[u32; 2]>,
-    history: HashMap<(u64, u64), TangentialHistory>,
+    /// Verlet lists of candidate pairs and facets (see [`NeighbourList`]).
+    pub neighbours: NeighbourList,
+    /// Tangential history of each candidate pair, aligned with the pair list.
+    history: Vec<TangentialHistory>,
+    /// History set from outside, to be matched to the pairs at the next list build.
+    pending_history: Option<HashMap<(u64, u64), TangentialHistory>>,
+    /// Bounding radius of every particle, and the pair results of the last step
+    /// (buffers kept between steps).
+    radii: Vec<Real>,
+    results: Vec<Option<ContactForce>>,
     wall_history: HashMap<WallKey, TangentialHistory>,
     damping: HashMap<u64, DampingTable>,
     /// Number of particle–particle and particle–wall contacts in the last step.
@@ -96,9 +103,11 @@ impl Engine {
         Engine {
             dt,
             regularisation_length: REGULARISATION_LENGTH,
-            broad: BroadPhase::default(),
-            pairs: Vec::new(),
-            history: HashMap::new(),
+            neighbours: NeighbourList::default(),
+            history: Vec::new(),
+            pending_history: None,
+            radii: Vec::new(),
+            results: Vec::new(),
             wall_history: HashMap::new(),
             damping: HashMap::new(),
             contacts: 0,
@@ -106,14 +115,29 @@ impl Engine {
         }
     }
 
-    /// Candidate particle pairs (bounding spheres overlapping) of the last step.
+    /// Candidate particle pairs (bounding spheres widened by the skin overlapping)
+    /// of the last step.
     pub fn candidate_pairs(&self) -> usize {
-        self.pairs.len()
+        self.neighbours.pairs().len()
+    }
+
+    /// The tangential history of the particle pairs, keyed by the two ids.
+    fn pair_history(&self) -> HashMap<(u64, u64), TangentialHistory> {
+        if let Some(pending) = &self.pending_history {
+            return pending.clone();
+        }
+        let list = &self.neighbours;
+        list.pairs()
+            .iter()
+            .zip(&self.history)
+            .filter(|(_, h)| !h.is_empty())
+            .map(|(&pair, h)| (list.pair_ids(pair), *h))
+            .collect()
     }
 
     /// The tangential contact history, sorted by key.
     pub fn history(&self) -> ContactHistory {
-        let mut pairs: Vec<_> = self.history.iter().map(|(k, h)| (*k, *h)).collect();
+        let mut pairs: Vec<_> = self.pair_history().into_iter().collect();
         let mut walls: Vec<_> = self.wall_history.iter().map(|(k, h)| (*k, *h)).collect();
         pairs.sort_by_key(|e| e.0);
         walls.sort_by_key(|e| e.0);
@@ -122,7 +146,8 @@ impl Engine {
 
     /// Replaces the tangential contact history (see [`Engine::history`]).
     pub fn set_history(&mut self, history: ContactHistory) {
-        self.history = history.pairs.into_iter().collect();
+        self.pending_history = Some(history.pairs.into_iter().collect());
+        self.neighbours.invalidate();
         self.wall_history = history.walls.into_iter().collect();
     }
 
@@ -136,31 +161,44 @@ impl Engine {
         let dt = self.dt;
         let types = &world.body_types;
         let p = &mut world.particles;
-        for i in 0..p.len() {
-            let t = &types[p.body_type[i] as usize];
-            p.velocity[i] += p.force[i] * (0.5 * dt / t.mass);
-            p.position[i] += p.velocity[i] * dt;
-            let mut rot = RotationState {
-                orientation: p.orientation[i],
-                angular_momentum: p.angular_momentum[i],
-            };
-            half_kick(&mut rot, &p.torque[i], dt);
-            free_rotation(&mut rot, &t.inertia, dt);
-            p.orientation[i] = rot.orientation;
-            p.angular_momentum[i] = rot.angular_momentum;
-        }
+        (
+            &mut p.position,
+            &mut p.velocity,
+            &mut p.orientation,
+            &mut p.angular_momentum,
+        )
+            .into_par_iter()
+            .zip((&p.force, &p.torque, &p.body_type))
+            .with_min_len(PARTICLES_PER_TASK)
+            .for_each(|((x, v, q, l), (f, t, &kind))| {
+                let kind = &types[kind as usize];
+                *v += f * (0.5 * dt / kind.mass);
+                *x += *v * dt;
+                let mut rot = RotationState {
+                    orientation: *q,
+                    angular_momentum: *l,
+                };
+                half_kick(&mut rot, t, dt);
+                free_rotation(&mut rot, &kind.inertia, dt);
+                *q = rot.orientation;
+                *l = rot.angular_momentum;
+            });
         for wall in &mut world.walls {
             wall.advance(world.time, dt);
         }
         world.follow_leaders();
         world.time += dt;
         self.compute_forces(world);
+        let types = &world.body_types;
         let p = &mut world.particles;
-        for i in 0..p.len() {
-            let mass = world.body_types[p.body_type[i] as usize].mass;
-            p.velocity[i] += p.force[i] * (0.5 * dt / mass);
-            p.angular_momentum[i] += p.torque[i] * (0.5 * dt);
-        }
+        (&mut p.velocity, &mut p.angular_momentum)
+            .into_par_iter()
+            .zip((&p.force, &p.torque, &p.body_type))
+            .with_min_len(PARTICLES_PER_TASK)
+            .for_each(|((v, l), (f, t, &kind))| {
+                *v += f * (0.5 * dt / types[kind as usize].mass);
+                *l += t * (0.5 * dt);
+            });
     }
 
     /// Calibrates the damping of every material pair once (a pair's restitution is
@@ -176,15 +214,38 @@ impl Engine {
         }
     }
 
+    /// Brings the candidate lists up to date, carrying the pairs' tangential history
+    /// over to a new list.
+    fn update_neighbours(&mut self, world: &World) {
+        let types = &world.body_types;
+        self.radii.clear();
+        self.radii.extend(
+            world
+                .particles
+                .body_type
+                .iter()
+                .map(|&k| types[k as usize].shape.circumradius()),
+        );
+        if !self.neighbours.is_stale(world) {
+            return;
+        }
+        let carried = self.pair_history();
+        self.pending_history = None;
+        self.neighbours.build(world, &self.radii);
+        let list = &self.neighbours;
+        self.history.clear();
+        self.history.extend(list.pairs().iter().map(|&pair| {
+            carried
+                .get(&list.pair_ids(pair))
+                .copied()
+                .unwrap_or_default()
+        }));
+    }
+
     /// Forces and torques of the current positions and velocities.
     fn compute_forces(&mut self, world: &mut World) {
         self.prepare_damping(world);
-        let n = world.particles.len();
-        for i in 0..n {
-            let m = world.body_types[world.particles.body_type[i] as usize].mass;
-            world.particles.force[i] = world.gravity * m;
-            world.particles.torque[i] = Vector3::zeros();
-        }
+        self.update_neighbours(world);
         for wall in &mut world.walls {
             wall.force = Vector3::zeros();
             wall.torque = Vector3::zeros();
@@ -192,53 +253,78 @@ impl Engine {
                 .iter_mut()
                 .for_each(|f| *f = Vector3::zeros());
         }
-        let radii: Vec<Real> = (0..n)
-            .map(|i| {
-                world.body_types[world.particles.body_type[i] as usize]
-                    .shape
-                    .circumradius()
-            })
-            .collect();
-        self.broad
-            .find_pairs(&world.particles.position, &radii, 0.0, &mut self.pairs);
 
+        // Particle pairs, in parallel over the candidate pairs; each pair's history
+        // is replaced by the one its contact leaves (empty when they do not touch).
         let w = &*world;
-        let history = &self.history;
-        let damping = &self.damping;
+        let (radii, damping) = (&self.radii, &self.damping);
         let law = LawParams {
             dt: self.dt,
             regularisation_length: self.regularisation_length,
         };
-        let results: Vec<Option<ContactForce>> = self
-            .pairs
-            .par_iter()
-            .map(|&[i, j]| pair_force(w, i as usize, j as usize, history, damping, &law))
-            .collect();
-        let mut next_history = HashMap::with_capacity(results.len());
-        let mut contacts = 0;
-        let mut energy = 0.0;
-        for (&[i, j], r) in self.pairs.iter().zip(&results) {
-            let Some(c) = r else { continue };
-            let (i, j) = (i as usize, j as usize);
+        let pairs = self.neighbours.pairs();
+        self.results.clear();
+        self.results.par_extend(
+            pairs
+                .par_iter()
+                .zip(&mut self.history)
+                .with_min_len(PAIRS_PER_TASK)
+                .map(|(&[i, j], history)| {
+                    let (i, j) = (i as usize, j as usize);
+                    let reach = radii[i] + radii[j];
+                    let c = if (w.particles.position[j] - w.particles.position[i]).norm_squared()
+                        < reach * reach
+                    {
+                        pair_force(w, i, j, *history, damping, &law)
+                    } else {
+                        None
+                    };
+                    *history = c.map(|c| c.history).unwrap_or_default();
+                    c
+                }),
+        );
+
+        // Each particle gathers its pairs' forces in pair order (what a serial sweep
+        // over the pairs would add), so the sums do not depend on the threads.
+        let list = &self.neighbours;
+        let results = &self.results;
+        let p = &mut world.particles;
+        let (types, gravity, position) = (&world.body_types, world.gravity, &p.position);
+        (&mut p.force, &mut p.torque)
+            .into_par_iter()
+            .enumerate()
+            .with_min_len(PARTICLES_PER_TASK)
+            .for_each(|(k, (force, torque))| {
+                *force = gravity * types[p.body_type[k] as usize].mass;
+                *torque = Vector3::zeros();
+                for &index in list.incident(k) {
+                    let Some(c) = &results[index as usize] else {
+                        continue;
+                    };
+                    let [i, j] = list.pairs()[index as usize].map(|x| x as usize);
+                    if j == k {
+                        *force += c.force;
+                        *torque += c.torque;
+                    } else {
+                        *force -= c.force;
+                        *torque += c.reaction_torque(&position[i], &position[j]);
+                    }
+                }
+            });
+        let (mut contacts, mut energy) = (0, 0.0);
+        for c in self.results.iter().flatten() {
             contacts += 1;
             energy += c.energy;
-            let p = &mut world.particles;
-            p.force[j] += c.force;
-            p.force[i] -= c.force;
-            p.torque[j] += c.torque;
-            p.torque[i] += c.reaction_torque(&p.position[i], &p.position[j]);
-            if !c.history.is_empty() {
-                next_history.insert((p.id[i], p.id[j]), c.history);
-            }
         }
-        self.history = next_history;
 
         // Particles against walls, in parallel over particles.
         let w = &*world;
         let wall_history = &self.wall_history;
-        let wall_results: Vec<Vec<WallContact>> = (0..n)
+        let list = &self.neighbours;
+        let wall_results: Vec<Vec<WallContact>> = (0..w.particles.len())
             .into_par_iter()
-            .map(|i| wall_contacts(w, i, wall_history, damping, &law))
+            .with_min_len(PARTICLES_PER_TASK)
+            .map(|i| wall_contacts(w, i, list, wall_history, damping, &law))
             .collect();
         let mut next_wall_history = HashMap::new();
         for (i, list) in wall_results.into_iter().enumerate() {
@@ -273,6 +359,11 @@ impl Engine {
         self.elastic_energy = energy;
     }
 }
+
+/// Smallest share of particles and of pairs one rayon task takes: below it the
+/// scheduling costs more than the work.
+const PARTICLES_PER_TASK: usize = 256;
+const PAIRS_PER_TASK: usize = 64;
 
 /// Default regularisation length: below this fraction of the smaller equivalent
 /// radius, cubed, the volume law is continued quadratically (see
@@ -488,7 +579,7 @@ fn pair_force(
     world: &World,
     i: usize,
     j: usize,
-    history: &HashMap<(u64, u64), TangentialHistory>,
+    history: TangentialHistory,
     damping: &HashMap<u64, DampingTable>,
     law: &LawParams,
 ) -> Option<ContactForce> {
@@ -515,17 +606,13 @@ fn pair_force(
             + inverse_mass_at(world, j, &g.point, &g.normal),
         inertia: 1.0 / (1.0 / ti.inertia.min() + 1.0 / tj.inertia.min()),
     };
-    let h = history
-        .get(&(p.id[i], p.id[j]))
-        .copied()
-        .unwrap_or_default();
     Some(contact_force(
         &g,
         &motion,
         stiffness,
         &table,
         0.5 * (mi.friction + mj.friction),
-        h,
+        history,
         law.regularisation_volume(
             ti.shape
                 .equivalent_radius()
@@ -552,6 +639,7 @@ struct WallContact {
 fn wall_contacts(
     world: &World,
     i: usize,
+    list: &NeighbourList,
     history: &HashMap<WallKey, TangentialHistory>,
     damping: &HashMap<u64, DampingTable>,
     law: &LawParams,
@@ -561,19 +649,14 @@ fn wall_contacts(
     let radius = t.shape.circumradius();
     let pose = nalgebra::Isometry3::from_parts(p.position[i].coords.into(), p.orientation[i]);
     let mut out = Vec::new();
-    let mut facets = Vec::new();
     for (w, wall) in world.walls.iter().enumerate() {
-        wall.grid.query(
-            &wall.pose.inverse_transform_point(&p.position[i]),
-            radius,
-            &mut facets,
-        );
+        let facets = list.facets(i, w);
         if facets.is_empty() {
             continue;
         }
         // Patches: facets sharing a plane (to 1e-9 in the normal, 1e-9 R in offset).
         let mut patches: Vec<Patch> = Vec::new();
-        for &f in &facets {
+        for &f in facets {
             let tri = wall.facet_world(f as usize);
             let n = (tri[1] - tri[0]).cross(&(tri[2] - tri[0])).normalize();
             // Walls are one-sided: a particle whose centroid is behind a facet's plane

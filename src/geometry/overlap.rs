@@ -45,6 +45,7 @@ use std::cell::RefCell;
 use nalgebra::{Point3, Vector3};
 
 use super::gjk::{self, GjkResult};
+use super::plane::PlaneSoa;
 use super::polygon::{ConeSums, FixedPolygon, area_moment, clip_by_plane, vector_area};
 use super::sphere::closest_point_on_triangle;
 use super::{ConvexPolyhedron, Plane, Pose};
@@ -94,8 +95,7 @@ pub struct OverlapScratch {
     b_points: Vec<Point3<Real>>,
     b_planes: Vec<Plane>,
     soa: PlaneSoa,
-    /// All planes of A and B (culled path).
-    a_soa: PlaneSoa,
+    /// All planes of B (culled path).
     b_soa: PlaneSoa,
     /// Per face of A (B): the planes of B (A) it reaches.
     reach_a: Vec<u64>,
@@ -178,51 +178,6 @@ pub fn overlap_with(
 /// Coplanarity tolerance on plane distances.
 fn tolerance(a: &ConvexPolyhedron, b: &ConvexPolyhedron) -> Real {
     1e-12 * a.circumradius().max(b.circumradius())
-}
-
-/// Planes in structure-of-arrays form, padded to a multiple of 4 so that the
-/// distance loop vectorises.
-#[derive(Default, Debug)]
-struct PlaneSoa {
-    nx: Vec<Real>,
-    ny: Vec<Real>,
-    nz: Vec<Real>,
-    offset: Vec<Real>,
-}
-
-impl PlaneSoa {
-    /// Largest signed distance of `p` from the planes: positive when outside the solid
-    /// they bound.
-    fn max_distance(&self, p: &Point3<Real>) -> Real {
-        let mut lanes = [Real::NEG_INFINITY; 4];
-        for c in 0..self.nx.len() / 4 {
-            for (l, lane) in lanes.iter_mut().enumerate() {
-                let k = 4 * c + l;
-                let d = self.nx[k] * p.x + self.ny[k] * p.y + self.nz[k] * p.z - self.offset[k];
-                // A plain select (not f64::max) so that the loop vectorises.
-                *lane = if d > *lane { d } else { *lane };
-            }
-        }
-        lanes.iter().copied().fold(Real::NEG_INFINITY, Real::max)
-    }
-
-    fn fill(&mut self, planes: &[Plane]) {
-        let n = planes.len().next_multiple_of(4);
-        for v in [&mut self.nx, &mut self.ny, &mut self.nz, &mut self.offset] {
-            v.clear();
-        }
-        for p in planes {
-            self.nx.push(p.normal.x);
-            self.ny.push(p.normal.y);
-            self.nz.push(p.normal.z);
-            self.offset.push(p.offset);
-        }
-        // Padding planes never cut: every point is far inside them.
-        for v in [&mut self.nx, &mut self.ny, &mut self.nz] {
-            v.resize(n, 0.0);
-        }
-        self.offset.resize(n, Real::MAX);
-    }
 }
 
 /// Sets, per point, bit `k` of `out` when the point lies more than `tol` outside
@@ -364,8 +319,7 @@ fn overlap_masked(
     if s.out_a.iter().fold(u64::MAX, |m, &x| m & x) != 0 {
         return None;
     }
-    s.soa.fill(a.planes());
-    plane_masks(&s.b_points, &s.soa, tol, &mut s.out_b, &mut s.on_b);
+    plane_masks(&s.b_points, a.plane_soa(), tol, &mut s.out_b, &mut s.on_b);
     if s.out_b.iter().fold(u64::MAX, |m, &x| m & x) != 0 {
         return None;
     }
@@ -516,10 +470,8 @@ fn overlap_culled(
 
     s.a_spheres.clear();
     s.a_spheres.extend_from_slice(a.face_spheres());
-    s.a_soa.fill(a.planes());
     s.b_soa.fill(&s.b_planes);
     let OverlapScratch {
-        a_soa,
         b_soa,
         b_points,
         b_planes,
@@ -553,7 +505,7 @@ fn overlap_culled(
         planes: a.planes(),
         spheres: a_spheres,
         ids: a_faces,
-        soa: a_soa,
+        soa: a.plane_soa(),
     };
     let side_b = LocalSide {
         shape: b,

@@ -48,3 +48,48 @@ impl Plane {
         }
     }
 }
+
+/// Planes in structure-of-arrays form, padded to a multiple of 4 so that the
+/// distance loop vectorises.
+#[derive(Clone, Default, Debug)]
+pub(crate) struct PlaneSoa {
+    pub(crate) nx: Vec<Real>,
+    pub(crate) ny: Vec<Real>,
+    pub(crate) nz: Vec<Real>,
+    pub(crate) offset: Vec<Real>,
+}
+
+impl PlaneSoa {
+    /// Largest signed distance of `p` from the planes: positive when outside the solid
+    /// they bound.
+    pub(crate) fn max_distance(&self, p: &Point3<Real>) -> Real {
+        let mut lanes = [Real::NEG_INFINITY; 4];
+        for c in 0..self.nx.len() / 4 {
+            for (l, lane) in lanes.iter_mut().enumerate() {
+                let k = 4 * c + l;
+                let d = self.nx[k] * p.x + self.ny[k] * p.y + self.nz[k] * p.z - self.offset[k];
+                // A plain select (not f64::max) so that the loop vectorises.
+                *lane = if d > *lane { d } else { *lane };
+            }
+        }
+        lanes.iter().copied().fold(Real::NEG_INFINITY, Real::max)
+    }
+
+    pub(crate) fn fill(&mut self, planes: &[Plane]) {
+        let n = planes.len().next_multiple_of(4);
+        for v in [&mut self.nx, &mut self.ny, &mut self.nz, &mut self.offset] {
+            v.clear();
+        }
+        for p in planes {
+            self.nx.push(p.normal.x);
+            self.ny.push(p.normal.y);
+            self.nz.push(p.normal.z);
+            self.offset.push(p.offset);
+        }
+        // Padding planes never cut: every point is far inside them.
+        for v in [&mut self.nx, &mut self.ny, &mut self.nz] {
+            v.resize(n, 0.0);
+        }
+        self.offset.resize(n, Real::MAX);
+    }
+}

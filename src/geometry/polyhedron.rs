@@ -4,6 +4,7 @@ use std::collections::HashMap;
 
 use nalgebra::{Isometry3, Matrix3, Point3, Rotation3, Translation3, UnitQuaternion, Vector3};
 
+use super::plane::PlaneSoa;
 use super::{GeometryError, MassProperties, Plane, TriMesh};
 use crate::Real;
 
@@ -33,6 +34,8 @@ pub struct ConvexPolyhedron {
     /// `face_loops[face_starts[f]..face_starts[f + 1]]` is face `f`.
     face_starts: Vec<u32>,
     planes: Vec<Plane>,
+    /// The same planes in structure-of-arrays form (for the overlap kernel).
+    plane_soa: PlaneSoa,
     edges: Vec<[u32; 2]>,
     /// Vertex adjacency in compressed rows (for hill-climbing support queries).
     neighbour_starts: Vec<u32>,
@@ -156,11 +159,14 @@ impl ConvexPolyhedron {
             .iter()
             .map(|v| v.coords.norm())
             .fold(0.0, Real::max);
+        let mut plane_soa = PlaneSoa::default();
+        plane_soa.fill(&planes);
         ConvexPolyhedron {
             vertices,
             face_loops,
             face_starts,
             planes,
+            plane_soa,
             edges,
             neighbour_starts,
             neighbours,
@@ -190,6 +196,11 @@ impl ConvexPolyhedron {
     /// Outward supporting planes of the faces, in the body frame.
     pub fn planes(&self) -> &[Plane] {
         &self.planes
+    }
+
+    /// Face planes in structure-of-arrays form, padded to a multiple of four.
+    pub(crate) fn plane_soa(&self) -> &PlaneSoa {
+        &self.plane_soa
     }
 
     /// Bounding sphere of each face (centre, radius), in the body frame.
@@ -292,6 +303,7 @@ impl ConvexPolyhedron {
         for p in &mut out.planes {
             p.offset *= factor;
         }
+        out.plane_soa.fill(&out.planes);
         for s in &mut out.face_spheres {
             s.0 *= factor;
             s.1 *= factor;

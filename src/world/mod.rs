@@ -113,6 +113,9 @@ impl World {
     pub fn angular_velocity(&self, i: usize) -> Vector3<Real> {
         let p = &self.particles;
         let inertia = &self.body_types[p.body_type[i] as usize].inertia;
+        if crate::engine::integrate::is_isotropic(inertia) {
+            return p.angular_momentum[i] / inertia.x;
+        }
         let q = p.orientation[i];
         q * q
             .inverse_transform_vector(&p.angular_momentum[i])

@@ -1,0 +1,194 @@
+//! Verlet lists: the candidate particle pairs and particle–facet candidates of the
+//! last broad phase, kept while no particle has moved far enough to make a new
+//! contact that the lists miss.
+//!
+//! # Invariant
+//! The lists were built with every reach widened by the skin `s`: a pair `(i, j)` is
+//! listed when `|x_i − x_j| < r_i + r_j + s`, and a facet of wall `w` is listed for
+//! particle `i` when its bounding box meets the ball of radius `r_i + s` about `x_i` in
+//! the wall's frame. They are rebuilt before any particle has moved more than `s / 2`
+//! in the world since the build (then two particles have approached by less than `s`)
+//! or more than `s` in the frame of a wall (a wall frame carries its facets rigidly),
+//! and whenever the particles or the walls' meshes change. So every pair whose bounding
+//! spheres overlap, and every facet a particle's bounding sphere can reach, is listed.
+//!
+//! # Order
+//! Pairs are sorted by `(i, j)` and each particle's facets by index, so the contacts
+//! found through the lists come in an order that depends on the state alone, not on
+//! when the lists were built: a run restored from a saved state continues bit for bit.
+//!
+//! # Why
+//! Rebuilding the grid, counting and writing the pairs every step cost as much as the
+//! sphere contacts themselves; a settled bed keeps its lists for hundreds of steps,
+//! and a falling one for a few dozen at the suggested step.
+
+use nalgebra::Point3;
+use rayon::prelude::*;
+
+use super::broad_phase::BroadPhase;
+use crate::Real;
+use crate::world::World;
+
+/// Skin as a fraction of the smallest bounding radius when none is set.
+pub const DEFAULT_SKIN: Real = 0.2;
+
+/// The candidate lists of one engine (see the module docs for the invariant).
+#[derive(Clone, Debug, Default)]
+pub struct NeighbourList {
+    /// Skin width; `None`: [`DEFAULT_SKIN`] times the smallest bounding radius.
+    pub skin: Option<Real>,
+    broad: BroadPhase,
+    /// Candidate pairs `[i, j]`, `i < j`, sorted.
+    pairs: Vec<[u32; 2]>,
+    /// `incident[incident_starts[k]..incident_starts[k + 1]]`: the pairs holding
+    /// particle `k`, ascending.
+    incident_starts: Vec<u32>,
+    incident: Vec<u32>,
+    /// `facets[facet_starts[k * walls + w]..facet_starts[k * walls + w + 1]]`: the
+    /// facets of wall `w` near particle `k`, ascending.
+    facet_starts: Vec<u32>,
+    facets: Vec<u32>,
+    /// What the lists were built from: particle ids and positions, positions in every
+    /// wall's frame (particle-major), and each wall's facet count.
+    ids: Vec<u64>,
+    anchors: Vec<Point3<Real>>,
+    wall_anchors: Vec<Point3<Real>>,
+    wall_facets: Vec<usize>,
+    /// Skin the lists were built with.
+    built_skin: Real,
+    valid: bool,
+    builds: u64,
+}
+
+impl NeighbourList {
+    /// Makes the next [`Self::update`] rebuild.
+    pub fn invalidate(&mut self) {
+        self.valid = false;
+    }
+
+    /// Candidate pairs, sorted.
+    pub fn pairs(&self) -> &[[u32; 2]] {
+        &self.pairs
+    }
+
+    /// Indices into [`Self::pairs`] of the pairs holding particle `k`, ascending.
+    pub fn incident(&self, k: usize) -> &[u32] {
+        &self.incident[self.incident_starts[k] as usize..self.incident_starts[k + 1] as usize]
+    }
+
+    /// Facets of wall `w` that particle `k` may touch, ascending.
+    pub fn facets(&self, k: usize, w: usize) -> &[u32] {
+        let slot = k * self.wall_facets.len() + w;
+        &self.facets[self.facet_starts[slot] as usize..self.facet_starts[slot + 1] as usize]
+    }
+
+    /// The ids of the two particles of a listed pair (as they were at the build).
+    pub fn pair_ids(&self, [i, j]: [u32; 2]) -> (u64, u64) {
+        (self.ids[i as usize], self.ids[j as usize])
+    }
+
+    /// Number of builds so far.
+    pub fn builds(&self) -> u64 {
+        self.builds
+    }
+
+    /// Whether the lists must be rebuilt before they are used for `world`: never
+    /// built or invalidated, other particles or wall meshes, or moved too far.
+    pub fn is_stale(&self, world: &World) -> bool {
+        let p = &world.particles;
+        if !self.valid
+            || p.id != self.ids
+            || world.walls.len() != self.wall_facets.len()
+            || world
+                .walls
+                .iter()
+                .zip(&self.wall_facets)
+                .any(|(w, &n)| w.triangles.len() != n)
+        {
+            return true;
+        }
+        let s = self.built_skin;
+        let (pair_limit, wall_limit) = ((0.5 * s) * (0.5 * s), s * s);
+        let walls = self.wall_facets.len();
+        (0..p.len()).into_par_iter().any(|k| {
+            let x = p.position[k];
+            (x - self.anchors[k]).norm_squared() >= pair_limit
+                || world.walls.iter().enumerate().any(|(w, wall)| {
+                    let local = wall.pose.inverse_transform_point(&x);
+                    (local - self.wall_anchors[k * walls + w]).norm_squared() >= wall_limit
+                })
+        })
+    }
+
+    /// Builds the lists for `world` (`radii`: each particle's bounding radius).
+    pub fn build(&mut self, world: &World, radii: &[Real]) {
+        let p = &world.particles;
+        let n = p.len();
+        let skin = self.skin.unwrap_or_else(|| {
+            DEFAULT_SKIN * radii.iter().copied().fold(Real::INFINITY, Real::min)
+        });
+        let skin = if skin.is_finite() { skin.max(0.0) } else { 0.0 };
+        self.built_skin = skin;
+
+        self.broad
+            .find_pairs(&p.position, radii, skin, &mut self.pairs);
+        self.pairs.par_sort_unstable();
+        self.index_incident(n);
+
+        let walls = world.walls.len();
+        self.wall_anchors.clear();
+        self.wall_anchors.extend(
+            (0..n)
+                .flat_map(|k| world.walls.iter().map(move |w| (k, w)))
+                .map(|(k, w)| w.pose.inverse_transform_point(&p.position[k])),
+        );
+        let lists: Vec<Vec<u32>> = (0..n * walls)
+            .into_par_iter()
+            .map(|slot| {
+                let (k, w) = (slot / walls, slot % walls);
+                let mut found = Vec::new();
+                world.walls[w]
+                    .grid
+                    .query(&self.wall_anchors[slot], radii[k] + skin, &mut found);
+                found
+            })
+            .collect();
+        self.facet_starts.clear();
+        self.facet_starts.push(0);
+        self.facets.clear();
+        for list in lists {
+            self.facets.extend_from_slice(&list);
+            self.facet_starts.push(self.facets.len() as u32);
+        }
+
+        self.ids.clone_from(&p.id);
+        self.anchors.clone_from(&p.position);
+        self.wall_facets.clear();
+        self.wall_facets
+            .extend(world.walls.iter().map(|w| w.triangles.len()));
+        self.valid = true;
+        self.builds += 1;
+    }
+
+    /// Fills the per-particle incidence lists of the (sorted) pairs.
+    fn index_incident(&mut self, n: usize) {
+        self.incident_starts.clear();
+        self.incident_starts.resize(n + 1, 0);
+        for &[i, j] in &self.pairs {
+            self.incident_starts[i as usize + 1] += 1;
+            self.incident_starts[j as usize + 1] += 1;
+        }
+        for k in 0..n {
+            self.incident_starts[k + 1] += self.incident_starts[k];
+        }
+        self.incident.clear();
+        self.incident.resize(self.incident_starts[n] as usize, 0);
+        let mut fill = self.incident_starts.clone();
+        for (index, &[i, j]) in self.pairs.iter().enumerate() {
+            for k in [i as usize, j as usize] {
+                self.incident[fill[k] as usize] = index as u32;
+                fill[k] += 1;
+            }
+        }
+    }
+}
