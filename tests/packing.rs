@@ -181,3 +181,61 @@ fn the_component_reports_the_bed_height_and_porosity() {
         porosity
     );
 }
+
+/// An inlet fed "until a bed height": spheres (d = 5 mm) trickle into the N = 4 tube
+/// at 100 per second from 2–4 cm above the target, so that a few are in flight when
+/// feeding stops. The inlet stops short of its count, and the settled bed ends at
+/// the target plus what was in flight (under a layer: about 13 spheres make one
+/// diameter of bed here).
+#[test]
+fn an_inlet_feeds_until_the_bed_height_is_reached() {
+    use talus::analysis::packing::bed_figures;
+    use talus::scene::{Scene, Simulation};
+    let target = 0.03;
+    let d = 0.005;
+    let text = scene(3.0)
+        .replace(
+            "min = [-0.0065, -0.0065, 0.005]\nmax = [0.0065, 0.0065, 0.08]\nrate = 3000.0\ncount = 60",
+            &format!(
+                "min = [-0.0065, -0.0065, 0.05]\nmax = [0.0065, 0.0065, 0.07]\nrate = 100.0\ncount = 300\nbed_height = {target}"
+            ),
+        )
+        .replace(
+            "seed = 4\n",
+            "seed = 4\nsettle = { max_speed = 0.005, hold = 0.05 }\n",
+        );
+    assert!(text.contains("bed_height"));
+    let scene = Scene::parse(&text, Path::new("bed.toml")).expect("valid scene");
+    let bed = scene.bed.unwrap();
+    let mut sim = Simulation::new(&scene);
+    while !sim.is_settled() && sim.time() < 3.0 {
+        sim.step();
+    }
+    assert!(sim.is_settled(), "not at rest at {} s", sim.time());
+    let inserted = sim.inlets[0].inserted;
+    assert_eq!(sim.inlets[0].count, inserted, "the inlet stopped");
+    assert!((50..150).contains(&inserted), "{inserted} spheres");
+    let (height, porosity) = bed_figures(&sim.world, &bed).unwrap();
+    println!("{inserted} spheres, bed height {height:.4} m, porosity {porosity:.3}");
+    assert!(
+        height > target - 0.5 * d && height < target + 2.0 * d,
+        "bed height {height}"
+    );
+}
+
+/// A bed height to feed to needs the [bed] whose tube it is measured in.
+#[test]
+fn feeding_to_a_bed_height_needs_a_bed_section() {
+    let text = scene(0.1)
+        .replace("count = 60", "count = 60\nbed_height = 0.03")
+        .replace(
+            "[bed]\nbase = [0.0, 0.0, 0.0]\nradius = 0.01\nexclude = 0.005\n",
+            "",
+        );
+    let err = talus::scene::Scene::parse(&text, Path::new("bed.toml")).unwrap_err();
+    let message = err.to_string();
+    assert!(
+        message.contains("inlet[0].bed_height") && message.contains("[bed]"),
+        "{message}"
+    );
+}

@@ -351,9 +351,10 @@ struct Placed<'a> {
 }
 
 impl<'a> Placed<'a> {
-    fn new(world: &'a World, bed: &Bed) -> Result<Self, String> {
+    /// The particles of `world` that `keep` accepts, placed in the bed frame.
+    fn new(world: &'a World, bed: &Bed, keep: impl Fn(usize) -> bool) -> Result<Self, String> {
         let (tube, options) = (&bed.tube, &bed.options);
-        if world.particles.is_empty() {
+        if !(0..world.particles.len()).any(&keep) {
             return Err("the bed has no particles".into());
         }
         if !(tube.radius > 0.0) || !(tube.axis.norm() > 0.0) {
@@ -378,6 +379,7 @@ impl<'a> Placed<'a> {
         let frame = tube.frame();
         Ok(Placed {
             bodies: (0..world.particles.len())
+                .filter(|&i| keep(i))
                 .map(|i| Body::place(world, i, &frame))
                 .collect(),
             tube,
@@ -460,16 +462,23 @@ impl<'a> Placed<'a> {
 /// Bed height and bed-averaged porosity only (no profiles, coordination or
 /// orientations): cheap enough to follow a bed while it is being tapped.
 pub fn bed_figures(world: &World, bed: &Bed) -> Result<(Real, Real), String> {
-    let placed = Placed::new(world, bed)?;
+    let placed = Placed::new(world, bed, |_| true)?;
     let (_, height) = placed.axial();
     let (z0, z1) = placed.region(height, bed.options.region)?;
     let (v, _) = placed.volumes(z0, z1, &[placed.tube.radius]);
     Ok((height, 1.0 - v[0] / (placed.area() * (z1 - z0))))
 }
 
+/// Bed height of the particles that `member` marks: while a bed is fed, those
+/// touching something, so that particles in flight above it do not count.
+pub fn bed_height_of(world: &World, bed: &Bed, member: &[bool]) -> Result<Real, String> {
+    let placed = Placed::new(world, bed, |i| member.get(i) == Some(&true))?;
+    Ok(placed.axial().1)
+}
+
 /// Analyses the particles of `world` packed in the bed's tube.
 pub fn analyse(world: &World, bed: &Bed) -> Result<Packing, String> {
-    let placed = Placed::new(world, bed)?;
+    let placed = Placed::new(world, bed, |_| true)?;
     let (fractions, bed_height) = placed.axial();
     let (z0, z1) = placed.region(bed_height, bed.options.region)?;
     let (radius, bin) = (placed.tube.radius, placed.bin);

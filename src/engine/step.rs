@@ -88,6 +88,8 @@ pub struct Engine {
     /// (buffers kept between steps).
     radii: Vec<Real>,
     results: Vec<Option<ContactForce>>,
+    /// Whether each particle touched another or a wall at the last force evaluation.
+    touching: Vec<bool>,
     wall_history: HashMap<WallKey, TangentialHistory>,
     damping: HashMap<u64, DampingTable>,
     /// Number of particle–particle and particle–wall contacts in the last step.
@@ -108,6 +110,7 @@ impl Engine {
             pending_history: None,
             radii: Vec::new(),
             results: Vec::new(),
+            touching: Vec::new(),
             wall_history: HashMap::new(),
             damping: HashMap::new(),
             contacts: 0,
@@ -119,6 +122,12 @@ impl Engine {
     /// of the last step.
     pub fn candidate_pairs(&self) -> usize {
         self.neighbours.pairs().len()
+    }
+
+    /// Whether each particle touched another particle or a wall at the last force
+    /// evaluation (particles inserted since are not listed).
+    pub fn touching(&self) -> &[bool] {
+        &self.touching
     }
 
     /// The tangential history of the particle pairs, keyed by the two ids.
@@ -290,17 +299,20 @@ impl Engine {
         let results = &self.results;
         let p = &mut world.particles;
         let (types, gravity, position) = (&world.body_types, world.gravity, &p.position);
-        (&mut p.force, &mut p.torque)
+        self.touching.resize(p.len(), false);
+        (&mut p.force, &mut p.torque, &mut self.touching)
             .into_par_iter()
             .enumerate()
             .with_min_len(PARTICLES_PER_TASK)
-            .for_each(|(k, (force, torque))| {
+            .for_each(|(k, (force, torque, touching))| {
                 *force = gravity * types[p.body_type[k] as usize].mass;
                 *torque = Vector3::zeros();
+                *touching = false;
                 for &index in list.incident(k) {
                     let Some(c) = &results[index as usize] else {
                         continue;
                     };
+                    *touching = true;
                     let [i, j] = list.pairs()[index as usize].map(|x| x as usize);
                     if j == k {
                         *force += c.force;
@@ -337,6 +349,7 @@ impl Engine {
             {
                 contacts += 1;
                 energy += c.energy;
+                self.touching[i] = true;
                 let p = &mut world.particles;
                 p.force[i] += c.force;
                 p.torque[i] += c.torque;

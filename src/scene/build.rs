@@ -429,6 +429,15 @@ impl<'a> Builder<'a> {
         finite(path.key("max"), &spec.max)?;
         finite(path.key("velocity"), &spec.velocity)?;
         positive(path.key("rate"), spec.rate)?;
+        if let Some(h) = spec.bed_height {
+            positive(path.key("bed_height"), h)?;
+            if self.spec.bed.is_none() {
+                return Err(FieldError::new(
+                    path.key("bed_height"),
+                    "needs a [bed] section: the bed height is measured in its tube",
+                ));
+            }
+        }
         let r = self.world.body_types[t as usize].shape.circumradius();
         for i in 0..3 {
             if spec.max[i] - spec.min[i] < 2.0 * r {
@@ -441,7 +450,7 @@ impl<'a> Builder<'a> {
                 ));
             }
         }
-        Ok(Inlet::new(
+        let mut inlet = Inlet::new(
             t,
             spec.min.into(),
             spec.max.into(),
@@ -450,7 +459,9 @@ impl<'a> Builder<'a> {
             spec.velocity.into(),
             spec.start,
             self.spec.simulation.seed.wrapping_add(1 + k as u64),
-        ))
+        );
+        inlet.stop_height = spec.bed_height;
+        Ok(inlet)
     }
 
     fn wall(&self, path: &FieldPath, w: &WallSpec, cell: Real) -> Result<Wall> {

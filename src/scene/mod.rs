@@ -105,6 +105,14 @@ impl Scene {
                 format!("{reg} must lie in (0, 1)"),
             ));
         }
+        if let Some(skin) = spec.contact.skin
+            && !(skin.is_finite() && skin >= 0.0)
+        {
+            return Err(FieldError::new(
+                FieldPath::root("contact").key("skin"),
+                format!("{skin} must be a non-negative length"),
+            ));
+        }
         let built = build::Builder::new(&spec, &dir).build()?;
         let suggested = suggested_time_step(&built.world, reg);
         let mut warnings = Vec::new();

@@ -40,10 +40,12 @@ impl Plan {
             .count();
         let n_sphere = types.len() - n_poly;
         let inserted: usize = inlets.iter().map(|i| i.count).sum();
+        let until_height = inlets.iter().any(|i| i.stop_height.is_some());
         line(
             format!(
-                "particles: {} at start, {} from {} inlet(s)",
+                "particles: {} at start, {}{} from {} inlet(s)",
                 world.particles.len(),
+                if until_height { "up to " } else { "" },
                 inserted,
                 inlets.len()
             ),

@@ -6,6 +6,7 @@ use nalgebra::Vector3;
 use super::Scene;
 use super::spec::SettleSpec;
 use crate::Real;
+use crate::analysis::packing::{Bed, bed_height_of};
 use crate::engine::step::Engine;
 use crate::world::{Inlet, World};
 
@@ -25,7 +26,14 @@ pub struct Simulation {
     pub(super) next_id: u64,
     settle: Option<SettleSpec>,
     pub(super) quiet_since: Option<Real>,
+    /// The bed whose height stops inlets fed "until a bed height".
+    bed: Option<Bed>,
 }
+
+/// Simulated time between two measurements of the bed height while inlets feed
+/// until a height: a few pellets' worth of feeding at usual rates, and the exact
+/// volume integration it costs stays far below the steps in between.
+pub const BED_HEIGHT_INTERVAL: Real = 5e-3;
 
 /// Figures of the state after a step.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -47,6 +55,7 @@ impl Simulation {
     pub fn new(scene: &Scene) -> Self {
         let mut engine = Engine::new(scene.dt);
         engine.regularisation_length = scene.spec.contact.regularisation;
+        engine.neighbours.skin = scene.spec.contact.skin;
         let mut sim = Simulation {
             world: scene.world.clone(),
             engine,
@@ -56,6 +65,7 @@ impl Simulation {
             next_id: scene.next_id,
             settle: scene.spec.simulation.settle.clone(),
             quiet_since: None,
+            bed: scene.bed,
         };
         sim.insert();
         sim.engine.initialise(&mut sim.world);
@@ -74,8 +84,10 @@ impl Simulation {
 
     /// Advances one time step, then lets inlets insert what is due.
     pub fn step(&mut self) {
+        let before = self.world.time;
         self.engine.step(&mut self.world);
         self.steps += 1;
+        self.stop_inlets_at_bed_height(before);
         self.insert();
         self.update_settling();
     }
@@ -91,6 +103,44 @@ impl Simulation {
         for i in first..p.len() {
             p.force[i] = self.world.gravity * self.world.body_types[p.body_type[i] as usize].mass;
             p.torque[i] = Vector3::zeros();
+        }
+    }
+
+    /// Stops the inlets whose bed height is reached, measured once per
+    /// [`BED_HEIGHT_INTERVAL`] of simulated time (at its multiples, so a restored
+    /// run measures when the original did).
+    fn stop_inlets_at_bed_height(&mut self, before: Real) {
+        let Some(bed) = &self.bed else { return };
+        let feeding = |i: &Inlet| i.stop_height.is_some() && !i.is_done();
+        if !self.inlets.iter().any(feeding)
+            || (before / BED_HEIGHT_INTERVAL).floor()
+                == (self.world.time / BED_HEIGHT_INTERVAL).floor()
+        {
+            return;
+        }
+        // The bed: what touches something and moves slower than half of √(g d)
+        // (not particles in flight, nor those sliding down the tube wall). Nothing
+        // yet: no bed.
+        let w = &self.world;
+        let p = &w.particles;
+        let g = w.gravity.norm();
+        let member: Vec<bool> = (0..p.len())
+            .map(|i| {
+                let d = 2.0
+                    * w.body_types[p.body_type[i] as usize]
+                        .shape
+                        .equivalent_radius();
+                self.engine.touching().get(i) == Some(&true)
+                    && p.velocity[i].norm() < 0.5 * (g * d).sqrt()
+            })
+            .collect();
+        let Ok(height) = bed_height_of(w, bed, &member) else {
+            return;
+        };
+        for inlet in self.inlets.iter_mut().filter(|i| feeding(i)) {
+            if inlet.stop_height.is_some_and(|h| height >= h) {
+                inlet.stop();
+            }
         }
     }
 

@@ -188,12 +188,17 @@ pub struct ContactSpec {
     /// radius (see `contact::normal_force`).
     #[serde(default = "default_regularisation")]
     pub regularisation: Real,
+    /// Skin of the candidate lists, in metres (default 0.2 times the smallest
+    /// bounding radius): the lists are rebuilt once a particle has moved half of it.
+    /// Results do not depend on it; only the cost does.
+    pub skin: Option<Real>,
 }
 
 impl Default for ContactSpec {
     fn default() -> Self {
         ContactSpec {
             regularisation: default_regularisation(),
+            skin: None,
         }
     }
 }
@@ -515,4 +520,10 @@ pub struct InletSpec {
     /// Start time.
     #[serde(default)]
     pub start: Real,
+    /// Stop feeding once the bed of the scene's `[bed]` section is this high: its bed
+    /// height from the tube's base, counting the particles that touch another or a
+    /// wall and move slower than half of √(g d) (not those in flight or sliding
+    /// down the tube wall), measured every 5 ms of simulated time. `count`
+    /// stays the upper limit. Particles in flight when feeding stops still land.
+    pub bed_height: Option<Real>,
 }

@@ -20,7 +20,7 @@ use crate::Real;
 use crate::contact::TangentialHistory;
 use crate::engine::step::ContactHistory;
 
-const MAGIC: &[u8; 8] = b"TALUSST1";
+const MAGIC: &[u8; 8] = b"TALUSST2";
 
 /// Why bytes could not be restored as a state.
 #[derive(Debug, Error, PartialEq)]
@@ -217,6 +217,7 @@ impl Simulation {
         w.u64(self.inlets.len() as u64);
         for inlet in &self.inlets {
             w.u64(inlet.inserted as u64);
+            w.u64(inlet.count as u64);
             w.blob(&inlet.rng_state());
         }
 
@@ -330,6 +331,7 @@ impl Simulation {
         }
         for inlet in &mut self.inlets {
             inlet.inserted = r.u64()? as usize;
+            inlet.count = r.u64()? as usize;
             inlet
                 .set_rng_state(r.blob()?)
                 .map_err(|e| StateError::Corrupt(format!("inlet generator: {e}")))?;

@@ -28,8 +28,10 @@ pub struct Inlet {
     pub max: Point3<Real>,
     /// Particles per second.
     pub rate: Real,
-    /// Total to insert.
+    /// Total to insert (lowered to what was inserted when the inlet stops early).
     pub count: usize,
+    /// Bed height at which feeding stops (see [`Inlet::stop`]).
+    pub stop_height: Option<Real>,
     /// Velocity of inserted particles.
     pub velocity: Vector3<Real>,
     /// Start time.
@@ -58,6 +60,7 @@ impl Inlet {
             max,
             rate,
             count,
+            stop_height: None,
             velocity,
             start,
             inserted: 0,
@@ -74,6 +77,11 @@ impl Inlet {
     pub fn set_rng_state(&mut self, bytes: &[u8]) -> Result<(), serde_json::Error> {
         self.rng = serde_json::from_slice(bytes)?;
         Ok(())
+    }
+
+    /// Stops feeding: nothing more is inserted.
+    pub fn stop(&mut self) {
+        self.count = self.inserted;
     }
 
     /// Whether every particle has been inserted.
