@@ -1,10 +1,13 @@
 //! Helpers shared by the integration tests.
 #![allow(dead_code)]
 
+use std::path::Path;
+
 use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 use talus::geometry::ConvexPolyhedron;
+use talus::scene::{Scene, Simulation};
 
 /// A pose from a translation and a rotation vector (axis times angle).
 pub fn pose(t: [f64; 3], rot: [f64; 3]) -> Isometry3<f64> {
@@ -59,4 +62,50 @@ pub fn box_overlap(c1: [f64; 3], s1: [f64; 3], c2: [f64; 3], s2: [f64; 3]) -> f6
             (hi - lo).max(0.0)
         })
         .product()
+}
+
+/// Runs a scene until it settles (or `limit` simulated seconds pass) and checks that
+/// every particle came to rest inside `[lo, hi]` with finite state.
+pub fn settle(
+    text: &str,
+    lo: [f64; 3],
+    hi: [f64; 3],
+    limit: f64,
+    require_rest: bool,
+) -> Simulation {
+    let scene = Scene::parse(text, Path::new("pile.toml")).unwrap();
+    let mut sim = Simulation::new(&scene);
+    while !sim.is_settled() && sim.time() < limit {
+        sim.step();
+    }
+    let p = &sim.world.particles;
+    println!(
+        "{} particles, dt = {:.3e} s: settled = {} at t = {:.3} s after {} steps, largest speed {:.2e} m/s, {} contacts",
+        p.len(),
+        scene.dt,
+        sim.is_settled(),
+        sim.time(),
+        sim.steps,
+        sim.max_speed(),
+        sim.engine.contacts
+    );
+    for i in 0..p.len() {
+        let x = p.position[i];
+        assert!(
+            x.iter().all(|c| c.is_finite()) && p.velocity[i].iter().all(|c| c.is_finite()),
+            "particle {i} is not finite"
+        );
+        assert!(
+            (0..3).all(|k| x[k] > lo[k] && x[k] < hi[k]),
+            "particle {i} left the box: {x}"
+        );
+    }
+    if require_rest {
+        assert!(
+            sim.is_settled(),
+            "not at rest: largest speed {}",
+            sim.max_speed()
+        );
+    }
+    sim
 }
