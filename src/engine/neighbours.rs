@@ -61,7 +61,7 @@ pub struct NeighbourList {
 }
 
 impl NeighbourList {
-    /// Makes the next [`Self::update`] rebuild.
+    /// Makes the lists stale ([`Self::is_stale`]) until the next build.
     pub fn invalidate(&mut self) {
         self.valid = false;
     }

@@ -238,8 +238,10 @@ impl Engine {
         if !self.neighbours.is_stale(world) {
             return;
         }
-        let carried = self.pair_history();
-        self.pending_history = None;
+        let carried = match self.pending_history.take() {
+            Some(pending) => pending,
+            None => self.pair_history(),
+        };
         self.neighbours.build(world, &self.radii);
         let list = &self.neighbours;
         self.history.clear();
