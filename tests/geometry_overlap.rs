@@ -235,6 +235,64 @@ fn agrees_with_monte_carlo_on_random_convex_pairs() {
     }
 }
 
+/// Shapes of 65 to 128 vertices and at most 64 faces (a 40-gon prism: 80 vertices,
+/// 42 faces) take the bit-mask path with 128-bit vertex sets: the closed form of
+/// coaxial prisms, Monte Carlo at random poses, also against a 20-vertex shape.
+#[test]
+fn prisms_of_80_vertices() {
+    let (d, l) = (0.01, 0.012);
+    let a = generators::prism(40, d, l).unwrap();
+    assert_eq!((a.vertices().len(), a.face_count()), (80, 42));
+    // The axis: the normal of a cap (the face of 40 vertices).
+    let cap = (0..a.face_count())
+        .find(|&f| a.face(f).len() == 40)
+        .unwrap();
+    let axis = a.planes()[cap].normal;
+    for s in [0.1, 0.5, 0.93] {
+        let rel = Isometry3::translation(axis.x * s * l, axis.y * s * l, axis.z * s * l);
+        let o = overlap(&a, &a, &rel).unwrap();
+        let exact = a.volume() * (1.0 - s);
+        assert!(
+            (o.volume - exact).abs() < 1e-12 * a.volume(),
+            "shift {s}: {:e} vs {exact:e}",
+            o.volume
+        );
+        // A flat face-to-face contact (the flush sides left out): the cap area, along
+        // the axis from A towards B.
+        let cap_area = a.volume() / l;
+        assert!(
+            (o.area_vector() - axis * cap_area).norm() < 1e-9 * cap_area,
+            "{} vs {}",
+            o.area_vector(),
+            axis * cap_area
+        );
+    }
+    let dodecahedron = generators::platonic(Platonic::Dodecahedron, 0.006).unwrap();
+    let cases = [
+        (&a, &a, pose([0.006, 0.003, -0.004], [0.4, -1.1, 0.3])),
+        (&a, &a, pose([-0.002, 0.009, 0.001], [2.1, 0.5, -0.8])),
+        (
+            &a,
+            &dodecahedron,
+            pose([0.004, -0.005, 0.006], [0.1, 0.9, 1.7]),
+        ),
+        (
+            &dodecahedron,
+            &a,
+            pose([0.008, 0.001, 0.0], [-0.6, 0.2, 0.4]),
+        ),
+    ];
+    for (k, (a, b, rel)) in cases.iter().enumerate() {
+        let exact = overlap(a, b, rel).map_or(0.0, |o| o.volume);
+        let (mc, se) = monte_carlo_overlap(a, b, rel, 400_000, 40 + k as u64);
+        assert!(exact > 0.0);
+        assert!(
+            (exact - mc).abs() <= 4.0 * se,
+            "case {k}: exact {exact:e}, MC {mc:e} ± {se:e}"
+        );
+    }
+}
+
 #[test]
 fn rotated_square_prisms_make_an_octagon() {
     // Concentric unit cubes, one turned 45° about z: a regular octagon prism.

@@ -2,13 +2,13 @@
 //! forces (in parallel over pairs and over particles), accumulation in a fixed order,
 //! and the closing kick.
 
-use std::borrow::Cow;
 use std::collections::HashMap;
 
-use nalgebra::{Matrix3, Point3, Vector3};
+use nalgebra::{Point3, Vector3};
 use rayon::prelude::*;
 
 use super::integrate::{RotationState, free_rotation, half_kick};
+use super::laws::{ContactLaws, pair_restitution};
 use super::neighbours::NeighbourList;
 use crate::Real;
 use crate::contact::{
@@ -91,7 +91,7 @@ pub struct Engine {
     /// Whether each particle touched another or a wall at the last force evaluation.
     touching: Vec<bool>,
     wall_history: HashMap<WallKey, TangentialHistory>,
-    damping: HashMap<u64, DampingTable>,
+    laws: ContactLaws,
     /// Number of particle–particle and particle–wall contacts in the last step.
     pub contacts: usize,
     /// Elastic energy stored in all contacts' normal laws at the last force
@@ -112,7 +112,7 @@ impl Engine {
             results: Vec::new(),
             touching: Vec::new(),
             wall_history: HashMap::new(),
-            damping: HashMap::new(),
+            laws: ContactLaws::default(),
             contacts: 0,
             elastic_energy: 0.0,
         }
@@ -210,19 +210,6 @@ impl Engine {
             });
     }
 
-    /// Calibrates the damping of every material pair once (a pair's restitution is
-    /// the mean of its materials').
-    fn prepare_damping(&mut self, world: &World) {
-        for a in &world.materials {
-            for b in &world.materials {
-                let e = pair_restitution(a.restitution, b.restitution);
-                self.damping
-                    .entry(e.to_bits())
-                    .or_insert_with(|| DampingTable::new(e));
-            }
-        }
-    }
-
     /// Brings the candidate lists up to date, carrying the pairs' tangential history
     /// over to a new list.
     fn update_neighbours(&mut self, world: &World) {
@@ -255,7 +242,7 @@ impl Engine {
 
     /// Forces and torques of the current positions and velocities.
     fn compute_forces(&mut self, world: &mut World) {
-        self.prepare_damping(world);
+        self.laws.prepare(world, self.regularisation_length);
         self.update_neighbours(world);
         for wall in &mut world.walls {
             wall.force = Vector3::zeros();
@@ -268,11 +255,7 @@ impl Engine {
         // Particle pairs, in parallel over the candidate pairs; each pair's history
         // is replaced by the one its contact leaves (empty when they do not touch).
         let w = &*world;
-        let (radii, damping) = (&self.radii, &self.damping);
-        let law = LawParams {
-            dt: self.dt,
-            regularisation_length: self.regularisation_length,
-        };
+        let (radii, laws, dt) = (&self.radii, &self.laws, self.dt);
         let pairs = self.neighbours.pairs();
         self.results.clear();
         self.results.par_extend(
@@ -286,7 +269,7 @@ impl Engine {
                     let c = if (w.particles.position[j] - w.particles.position[i]).norm_squared()
                         < reach * reach
                     {
-                        pair_force(w, i, j, *history, damping, &law)
+                        pair_force(w, i, j, *history, laws, dt)
                     } else {
                         None
                     };
@@ -335,10 +318,14 @@ impl Engine {
         let w = &*world;
         let wall_history = &self.wall_history;
         let list = &self.neighbours;
+        let law = LawParams {
+            dt,
+            regularisation_length: self.regularisation_length,
+        };
         let wall_results: Vec<Vec<WallContact>> = (0..w.particles.len())
             .into_par_iter()
-            .with_min_len(PARTICLES_PER_TASK)
-            .map(|i| wall_contacts(w, i, list, wall_history, damping, &law))
+            .with_min_len(WALL_PARTICLES_PER_TASK)
+            .map(|i| wall_contacts(w, i, list, wall_history, laws, &law))
             .collect();
         let mut next_wall_history = HashMap::new();
         for (i, list) in wall_results.into_iter().enumerate() {
@@ -376,8 +363,11 @@ impl Engine {
 }
 
 /// Smallest share of particles and of pairs one rayon task takes: below it the
-/// scheduling costs more than the work.
+/// scheduling costs more than the work. A particle's wall contacts can cost as much
+/// as a hundred kick-drifts (a pellet against the facets of a tube), so their share
+/// is smaller: with 256, a bed of 1000 pellets kept 16 cores to 4 tasks.
 const PARTICLES_PER_TASK: usize = 256;
+const WALL_PARTICLES_PER_TASK: usize = 32;
 const PAIRS_PER_TASK: usize = 64;
 
 /// Default regularisation length: below this fraction of the smaller equivalent
@@ -400,42 +390,23 @@ impl LawParams {
     }
 }
 
-/// Restitution of a pair of materials.
-fn pair_restitution(a: Real, b: Real) -> Real {
-    0.5 * (a + b)
-}
-
-/// The calibrated damping of restitution `e`: borrowed from the tables prepared for
-/// every material pair, calibrated afresh only for a value that was not prepared.
-fn damping_table(damping: &HashMap<u64, DampingTable>, e: Real) -> Cow<'_, DampingTable> {
-    match damping.get(&e.to_bits()) {
-        Some(table) => Cow::Borrowed(table),
-        None => Cow::Owned(DampingTable::new(e)),
-    }
-}
-
-/// World-frame inverse inertia of particle `i`.
-fn inverse_inertia(world: &World, i: usize) -> Matrix3<Real> {
-    let p = &world.particles;
-    let t = &world.body_types[p.body_type[i] as usize];
-    let r = p.orientation[i].to_rotation_matrix();
-    r.matrix() * Matrix3::from_diagonal(&t.inertia.map(|x| 1.0 / x)) * r.matrix().transpose()
-}
-
-/// Inverse of the effective mass of particle `i` at `point` along `n`.
+/// Inverse of the effective mass of particle `i` at `point` along `n`: the lever
+/// `r × n` taken into the body frame, where the inertia is diagonal.
 fn inverse_mass_at(world: &World, i: usize, point: &Point3<Real>, n: &Vector3<Real>) -> Real {
     let p = &world.particles;
     let t = &world.body_types[p.body_type[i] as usize];
-    let rn = (point - p.position[i]).cross(n);
-    1.0 / t.mass + rn.dot(&(inverse_inertia(world, i) * rn))
+    let lever = p.orientation[i].inverse_transform_vector(&(point - p.position[i]).cross(n));
+    1.0 / t.mass + lever.component_div(&t.inertia).dot(&lever)
 }
 
-/// Velocity of particle `i`'s material at `point`.
-fn velocity_at(world: &World, i: usize, point: &Point3<Real>) -> Vector3<Real> {
-    world.particles.velocity[i]
-        + world
-            .angular_velocity(i)
-            .cross(&(point - world.particles.position[i]))
+/// Velocity of particle `i`'s material at `point`, given its angular velocity.
+fn velocity_at(
+    world: &World,
+    i: usize,
+    angular_velocity: &Vector3<Real>,
+    point: &Point3<Real>,
+) -> Vector3<Real> {
+    world.particles.velocity[i] + angular_velocity.cross(&(point - world.particles.position[i]))
 }
 
 /// Contact geometry of particles `i` and `j` in world coordinates (normal i → j).
@@ -595,46 +566,30 @@ fn pair_force(
     i: usize,
     j: usize,
     history: TangentialHistory,
-    damping: &HashMap<u64, DampingTable>,
-    law: &LawParams,
+    laws: &ContactLaws,
+    dt: Real,
 ) -> Option<ContactForce> {
     let g = pair_geometry(world, i, j)?;
     let p = &world.particles;
-    let (ti, tj) = (
-        &world.body_types[p.body_type[i] as usize],
-        &world.body_types[p.body_type[j] as usize],
-    );
-    let (mi, mj) = (&world.materials[ti.material], &world.materials[tj.material]);
-    let stiffness = PairStiffness::particles(
-        mi,
-        ti.shape.equivalent_radius(),
-        mj,
-        tj.shape.equivalent_radius(),
-    );
-    // The pair's restitution and friction: the means of the two materials'.
-    let e = pair_restitution(mi.restitution, mj.restitution);
-    let table = damping_table(damping, e);
+    let law = laws.pair(p.body_type[i], p.body_type[j]);
+    let (wi, wj) = (world.angular_velocity(i), world.angular_velocity(j));
     let motion = RelativeMotion {
-        velocity: velocity_at(world, j, &g.point) - velocity_at(world, i, &g.point),
-        spin: world.angular_velocity(j) - world.angular_velocity(i),
+        velocity: velocity_at(world, j, &wj, &g.point) - velocity_at(world, i, &wi, &g.point),
+        spin: wj - wi,
         inverse_mass: inverse_mass_at(world, i, &g.point, &g.normal)
             + inverse_mass_at(world, j, &g.point, &g.normal),
-        inertia: 1.0 / (1.0 / ti.inertia.min() + 1.0 / tj.inertia.min()),
+        inertia: law.inertia,
     };
     Some(contact_force(
         &g,
         &motion,
-        stiffness,
-        &table,
-        0.5 * (mi.friction + mj.friction),
+        law.stiffness,
+        laws.damping(law),
+        law.friction,
         history,
-        law.regularisation_volume(
-            ti.shape
-                .equivalent_radius()
-                .min(tj.shape.equivalent_radius()),
-        ),
+        law.regularisation,
         &p.position[j],
-        law.dt,
+        dt,
     ))
 }
 
@@ -656,7 +611,7 @@ fn wall_contacts(
     i: usize,
     list: &NeighbourList,
     history: &HashMap<WallKey, TangentialHistory>,
-    damping: &HashMap<u64, DampingTable>,
+    laws: &ContactLaws,
     law: &LawParams,
 ) -> Vec<WallContact> {
     let p = &world.particles;
@@ -749,14 +704,15 @@ fn wall_contacts(
         let pm = &world.materials[t.material];
         let stiffness = PairStiffness::particle_wall(pm, t.shape.equivalent_radius(), wm);
         let e = pair_restitution(pm.restitution, wm.restitution);
-        let table = damping_table(damping, e);
+        let table = laws.damping_of(e);
+        let spin = world.angular_velocity(i);
         for (key, g, facets) in patches {
             if !(g.area > 0.0) || !g.normal.iter().all(|x| x.is_finite()) {
                 continue;
             }
             let motion = RelativeMotion {
-                velocity: velocity_at(world, i, &g.point) - wall.velocity_at(&g.point),
-                spin: world.angular_velocity(i) - wall.angular_velocity,
+                velocity: velocity_at(world, i, &spin, &g.point) - wall.velocity_at(&g.point),
+                spin: spin - wall.angular_velocity,
                 inverse_mass: inverse_mass_at(world, i, &g.point, &g.normal),
                 inertia: t.inertia.min(),
             };

@@ -93,3 +93,26 @@ impl PlaneSoa {
         self.offset.resize(n, Real::MAX);
     }
 }
+
+/// Points in structure-of-arrays form, padded with the origin to a multiple of 4 so
+/// that the plane-distance loop runs four points at a time.
+#[derive(Clone, Default, Debug)]
+pub(crate) struct PointSoa {
+    pub(crate) x: Vec<Real>,
+    pub(crate) y: Vec<Real>,
+    pub(crate) z: Vec<Real>,
+}
+
+impl PointSoa {
+    pub(crate) fn fill(&mut self, points: &[Point3<Real>]) {
+        let n = points.len().next_multiple_of(4);
+        for (k, v) in [&mut self.x, &mut self.y, &mut self.z]
+            .into_iter()
+            .enumerate()
+        {
+            v.clear();
+            v.extend(points.iter().map(|p| p[k]));
+            v.resize(n, 0.0);
+        }
+    }
+}

@@ -139,6 +139,67 @@ impl ConeSums {
     }
 }
 
+/// Volume and first moment of a closed surface given as convex planar pieces with
+/// known outward unit normals, accumulated piece by piece (cones from the first
+/// piece's first vertex), together with each piece's vector area and area moment.
+///
+/// One pass over a piece's fan triangles gives all of it: every fan triangle of a
+/// convex planar piece has its vector area along the piece's normal `n`, so with
+/// `w_k = n · (p_k − p_0) × (p_{k+1} − p_0)` (twice its area) and `h` the height of
+/// the piece's plane over the cone apex `o`, the cone over the piece has volume
+/// `h Σ w_k / 6` and first moment `h Σ w_k (p_0 + p_k + p_{k+1} − 3o) / 24`, and the
+/// piece's area moment is `Σ w_k (p_0 + p_k + p_{k+1}) × n / 6`.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct SurfaceSums {
+    apex: Option<Point3<Real>>,
+    volume6: Real,
+    moment24: Vector3<Real>,
+}
+
+impl SurfaceSums {
+    /// Adds the convex piece `poly` (counter-clockwise about `normal`, at least three
+    /// vertices); returns its vector area and its area moment about the origin.
+    #[inline]
+    pub(crate) fn add_piece(
+        &mut self,
+        poly: &[Point3<Real>],
+        normal: &Vector3<Real>,
+    ) -> (Vector3<Real>, Vector3<Real>) {
+        let p0 = poly[0];
+        let apex = *self.apex.get_or_insert(p0);
+        let (mut twice_area, mut spread) = (0.0, Vector3::zeros());
+        for k in 1..poly.len() - 1 {
+            let (u, v) = (poly[k] - p0, poly[k + 1] - p0);
+            let w = normal.dot(&u.cross(&v));
+            twice_area += w;
+            spread += w * (u + v);
+        }
+        // Σ w_k (p_0 + p_k + p_{k+1}) = spread + 3 p_0 Σ w_k.
+        let offset = p0 - apex;
+        let h = offset.dot(normal);
+        self.volume6 += h * twice_area;
+        self.moment24 += h * (spread + 3.0 * twice_area * offset);
+        let weighted = spread + 3.0 * twice_area * p0.coords;
+        (normal * (0.5 * twice_area), weighted.cross(normal) / 6.0)
+    }
+
+    /// Whether no piece was added.
+    pub(crate) fn is_empty(&self) -> bool {
+        self.apex.is_none()
+    }
+
+    /// Enclosed volume.
+    pub(crate) fn volume(&self) -> Real {
+        self.volume6 / 6.0
+    }
+
+    /// Centroid of the enclosed volume (meaningless when the volume is zero or no
+    /// piece was added).
+    pub(crate) fn centroid(&self) -> Point3<Real> {
+        self.apex.unwrap_or_else(Point3::origin) + self.moment24 / (4.0 * self.volume6)
+    }
+}
+
 /// Most vertices a clipped face of a shape of at most 64 faces can have (a face has
 /// fewer than 64 vertices, and each of at most 64 cuts adds at most one).
 pub(crate) const MAX_CLIPPED: usize = 128;

@@ -4,7 +4,7 @@ use std::collections::HashMap;
 
 use nalgebra::{Isometry3, Matrix3, Point3, Rotation3, Translation3, UnitQuaternion, Vector3};
 
-use super::plane::PlaneSoa;
+use super::plane::{PlaneSoa, PointSoa};
 use super::{GeometryError, MassProperties, Plane, TriMesh};
 use crate::Real;
 
@@ -36,6 +36,11 @@ pub struct ConvexPolyhedron {
     planes: Vec<Plane>,
     /// The same planes in structure-of-arrays form (for the overlap kernel).
     plane_soa: PlaneSoa,
+    /// The vertices in structure-of-arrays form (for the overlap kernel).
+    vertex_soa: PointSoa,
+    /// Per face, bit `v` set for each of its vertices `v < 128` (for the overlap
+    /// kernel's bit-mask path, used only on shapes of at most 128 vertices).
+    face_vertex_masks: Vec<u128>,
     edges: Vec<[u32; 2]>,
     /// Vertex adjacency in compressed rows (for hill-climbing support queries).
     neighbour_starts: Vec<u32>,
@@ -43,6 +48,8 @@ pub struct ConvexPolyhedron {
     /// Bounding sphere (centre, radius) of every face, for culling on large meshes.
     face_spheres: Vec<(Point3<Real>, Real)>,
     volume: Real,
+    /// Radius of the sphere of equal volume (kept: contact laws read it per pair).
+    equivalent_radius: Real,
     principal_inertia: Vector3<Real>,
     circumradius: Real,
     /// Maps body coordinates to the coordinates of the mesh it was built from.
@@ -161,17 +168,30 @@ impl ConvexPolyhedron {
             .fold(0.0, Real::max);
         let mut plane_soa = PlaneSoa::default();
         plane_soa.fill(&planes);
+        let mut vertex_soa = PointSoa::default();
+        vertex_soa.fill(&vertices);
+        let face_vertex_masks = (0..loops.len())
+            .map(|f| {
+                face_loops[face_starts[f] as usize..face_starts[f + 1] as usize]
+                    .iter()
+                    .filter(|&&v| v < 128)
+                    .fold(0u128, |m, &v| m | 1 << v)
+            })
+            .collect();
         ConvexPolyhedron {
             vertices,
             face_loops,
             face_starts,
             planes,
             plane_soa,
+            vertex_soa,
+            face_vertex_masks,
             edges,
             neighbour_starts,
             neighbours,
             face_spheres,
             volume,
+            equivalent_radius: (3.0 * volume / (4.0 * std::f64::consts::PI)).cbrt(),
             principal_inertia,
             circumradius,
             body_to_input,
@@ -201,6 +221,16 @@ impl ConvexPolyhedron {
     /// Face planes in structure-of-arrays form, padded to a multiple of four.
     pub(crate) fn plane_soa(&self) -> &PlaneSoa {
         &self.plane_soa
+    }
+
+    /// Vertices in structure-of-arrays form, padded to a multiple of four.
+    pub(crate) fn vertex_soa(&self) -> &PointSoa {
+        &self.vertex_soa
+    }
+
+    /// Per face, its vertex set as bits (vertices below 128 only).
+    pub(crate) fn face_vertex_masks(&self) -> &[u128] {
+        &self.face_vertex_masks
     }
 
     /// Bounding sphere of each face (centre, radius), in the body frame.
@@ -236,7 +266,7 @@ impl ConvexPolyhedron {
 
     /// Radius of the sphere of equal volume.
     pub fn equivalent_radius(&self) -> Real {
-        (3.0 * self.volume / (4.0 * std::f64::consts::PI)).cbrt()
+        self.equivalent_radius
     }
 
     /// The pose of the body frame in the frame of the mesh it was built from.
@@ -304,6 +334,7 @@ impl ConvexPolyhedron {
             p.offset *= factor;
         }
         out.plane_soa.fill(&out.planes);
+        out.vertex_soa.fill(&out.vertices);
         for s in &mut out.face_spheres {
             s.0 *= factor;
             s.1 *= factor;
@@ -311,6 +342,7 @@ impl ConvexPolyhedron {
         out.volume *= factor.powi(3);
         out.principal_inertia *= factor.powi(5);
         out.circumradius *= factor;
+        out.equivalent_radius *= factor;
         out.body_to_input.translation.vector *= factor;
         out
     }

@@ -1,0 +1,423 @@
+//! The bit-mask path for shapes of at most 64 faces and 128 vertices.
+//!
+//! For every plane of one shape, one bit per vertex of the other says whether the
+//! vertex lies outside the plane, and one whether it lies on it (within the
+//! coplanarity tolerance). Every decision about a face and a plane of the other shape
+//! is then an AND of such a mask with the face's vertex set:
+//!
+//! - a plane with every vertex of the other shape outside separates the shapes;
+//! - a face can only meet the other solid if that solid straddles the face's plane
+//!   (or touches it from inside): the face is *live*;
+//! - a face with every vertex outside one plane of the other solid misses it;
+//! - a plane g with some of the face's vertices outside cuts the face, but within the
+//!   face's plane f the other solid is bounded only by the planes of its faces that
+//!   reach plane f (have vertices on both sides of it, or on it): clipping by the
+//!   others would cut nothing that those do not, so they are skipped.
+//!
+//! The masks of one plane are computed four vertices at a time (AVX2 where the CPU
+//! has it); the face decisions cost a few integer operations per face and plane.
+
+use std::ops::{BitAnd, BitOr, Not};
+
+use nalgebra::{Point3, Vector3};
+
+use super::{OverlapGeometry, OverlapScratch, Pieces, summarise, tolerance};
+use crate::Real;
+use crate::geometry::plane::PointSoa;
+use crate::geometry::polygon::FixedPolygon;
+use crate::geometry::{ConvexPolyhedron, Plane};
+
+/// The overlap of `a` and `b` (B's vertices and planes already in A's frame in `s`;
+/// `t` is B's centroid in A's frame).
+pub(super) fn overlap_masked(
+    a: &ConvexPolyhedron,
+    b: &ConvexPolyhedron,
+    t: &Vector3<Real>,
+    s: &mut OverlapScratch,
+) -> Option<OverlapGeometry> {
+    // Most shapes have at most 64 vertices: their sets take half the operations.
+    if a.vertices().len() <= 64 && b.vertices().len() <= 64 {
+        overlap_with_sets::<u64>(a, b, t, s)
+    } else {
+        overlap_with_sets::<u128>(a, b, t, s)
+    }
+}
+
+/// [`overlap_masked`] with vertex sets of type `M`.
+fn overlap_with_sets<M: VertexSet>(
+    a: &ConvexPolyhedron,
+    b: &ConvexPolyhedron,
+    t: &Vector3<Real>,
+    s: &mut OverlapScratch,
+) -> Option<OverlapGeometry> {
+    let tol = tolerance(a, b);
+    // Planes that hold the other shape's bounding sphere wholly inside can neither
+    // cut nor separate; about half of each shape's planes face away from the other.
+    let reached_a = planes_reached(a.planes(), &Point3::from(*t), b.circumradius(), tol);
+    let reached_b = planes_reached(&s.b_planes, &Point3::origin(), a.circumradius(), tol);
+    let (all_a, all_b) = (M::first(a.vertices().len()), M::first(b.vertices().len()));
+    let (out_a, on_a) = (&mut s.out_a, &mut s.on_a);
+    vertex_masks(
+        a.vertex_soa(),
+        &s.b_planes,
+        reached_b,
+        tol,
+        all_a,
+        out_a,
+        on_a,
+    );
+    let (out_b, on_b) = (&mut s.out_b, &mut s.on_b);
+    vertex_masks(
+        &s.b_point_soa,
+        a.planes(),
+        reached_a,
+        tol,
+        all_b,
+        out_b,
+        on_b,
+    );
+    let side_a = MaskedSide::<M>::new(a, a.planes(), reached_a, &s.out_a, &s.on_a);
+    let side_b = MaskedSide::<M>::new(b, &s.b_planes, reached_b, &s.out_b, &s.on_b);
+    if side_a.separated() || side_b.separated() {
+        return None;
+    }
+
+    // Faces of A clipped by B; flush pieces are kept apart.
+    let mut pieces = Pieces::default();
+    for f in bits(reached_a) {
+        let Some(cut) = face_cut(&side_a, &side_b, f) else {
+            continue;
+        };
+        s.fixed
+            .set(a.face(f).iter().map(|&v| a.vertices()[v as usize]));
+        clip_by_planes(&mut s.fixed, &cut, &s.b_planes);
+        if !s.fixed.is_degenerate() {
+            let normal = a.planes()[f].normal;
+            pieces.add(s.fixed.points(), &normal, false, cut.flush, &mut s.points);
+        }
+    }
+
+    // Faces of B clipped by A; a face lying in a plane of A of equal orientation is
+    // already covered by A's face.
+    for g in bits(reached_b) {
+        let Some(cut) = face_cut(&side_b, &side_a, g) else {
+            continue;
+        };
+        if cut.flush {
+            continue;
+        }
+        s.fixed
+            .set(b.face(g).iter().map(|&v| s.b_points[v as usize]));
+        clip_by_planes(&mut s.fixed, &cut, a.planes());
+        if !s.fixed.is_degenerate() {
+            let normal = s.b_planes[g].normal;
+            pieces.add(s.fixed.points(), &normal, true, false, &mut s.points);
+        }
+    }
+    summarise(&s.points, &pieces, t)
+}
+
+/// A set of vertices, one bit each: `u64` for shapes of up to 64 vertices, `u128`
+/// for up to 128.
+trait VertexSet: Copy + Eq + BitAnd<Output = Self> + BitOr<Output = Self> + Not<Output = Self> {
+    const EMPTY: Self;
+    /// Vertices `0..n`.
+    fn first(n: usize) -> Self;
+    /// The set of the vertices below the width of `Self` in `bits`.
+    fn narrow(bits: u128) -> Self;
+    fn widen(self) -> u128;
+    /// The set shifted up by four vertices, with vertices 0..4 from `nibble`.
+    fn shifted_in(self, nibble: i32) -> Self;
+}
+
+macro_rules! vertex_set {
+    ($t:ty) => {
+        impl VertexSet for $t {
+            const EMPTY: Self = 0;
+            fn first(n: usize) -> Self {
+                if n >= <$t>::BITS as usize {
+                    <$t>::MAX
+                } else {
+                    (1 << n) - 1
+                }
+            }
+            #[inline]
+            fn narrow(bits: u128) -> Self {
+                bits as $t
+            }
+            #[inline]
+            fn widen(self) -> u128 {
+                self as u128
+            }
+            #[inline]
+            fn shifted_in(self, nibble: i32) -> Self {
+                (self << 4) | nibble as $t
+            }
+        }
+    };
+}
+vertex_set!(u64);
+vertex_set!(u128);
+
+/// One shape as the other's planes see it.
+struct MaskedSide<'a, M> {
+    shape: &'a ConvexPolyhedron,
+    /// Its face planes, in A's frame.
+    planes: &'a [Plane],
+    /// Its planes (bits) that the other shape's bounding sphere reaches: the others
+    /// have every vertex of the other shape inside.
+    reached: u64,
+    /// Per plane of the *other* shape: this shape's vertices outside it, and on it
+    /// (no bits beyond its vertices).
+    out: &'a [u128],
+    on: &'a [u128],
+    /// All of this shape's vertices.
+    all: M,
+}
+
+impl<'a, M: VertexSet> MaskedSide<'a, M> {
+    fn new(
+        shape: &'a ConvexPolyhedron,
+        planes: &'a [Plane],
+        reached: u64,
+        out: &'a [u128],
+        on: &'a [u128],
+    ) -> Self {
+        MaskedSide {
+            shape,
+            planes,
+            reached,
+            out,
+            on,
+            all: M::first(shape.vertices().len()),
+        }
+    }
+
+    /// Whether one plane of the other shape has every vertex of this one outside.
+    fn separated(&self) -> bool {
+        self.out.iter().any(|&m| M::narrow(m) == self.all)
+    }
+
+    #[inline]
+    fn out(&self, plane: usize) -> M {
+        M::narrow(self.out[plane])
+    }
+
+    #[inline]
+    fn on(&self, plane: usize) -> M {
+        M::narrow(self.on[plane])
+    }
+}
+
+/// How a face meets the other solid.
+struct FaceCut {
+    /// The other shape's planes to clip the face by.
+    planes: u64,
+    /// Whether the face lies in a plane of the other shape of equal orientation.
+    flush: bool,
+}
+
+/// How face `f` of `own` meets `other`: `None` when it cannot bound the intersection.
+#[inline(always)]
+fn face_cut<M: VertexSet>(own: &MaskedSide<M>, other: &MaskedSide<M>, f: usize) -> Option<FaceCut> {
+    let empty = M::EMPTY;
+    // The other shape's vertices against this face's plane.
+    let (out_f, on_f) = (other.out(f), other.on(f));
+    let in_f = other.all & !(out_f | on_f);
+    let straddles = out_f != empty && in_f != empty;
+    let touches_from_inside = on_f != empty && out_f == empty;
+    if !(straddles || touches_from_inside) {
+        return None;
+    }
+    let face = M::narrow(own.shape.face_vertex_masks()[f]);
+    let normal = own.planes[f].normal;
+    let other_faces = other.shape.face_vertex_masks();
+    let mut cut = FaceCut {
+        planes: 0,
+        flush: false,
+    };
+    for g in bits(other.reached) {
+        let outside = face & own.out(g);
+        if outside == face {
+            return None;
+        }
+        if outside == empty {
+            if face & own.on(g) == face && other.planes[g].normal.dot(&normal) > 0.0 {
+                cut.flush = true;
+            }
+            continue;
+        }
+        // Face g of the other shape reaches plane f: vertices on both sides, or on it.
+        let other_face = M::narrow(other_faces[g]);
+        let reaches = (other_face & out_f != empty && other_face & in_f != empty)
+            || other_face & on_f != empty;
+        cut.planes |= (reaches as u64) << g;
+    }
+    Some(cut)
+}
+
+/// Planes (bits) whose outside the ball (`centre`, `radius`) reaches to within `tol`.
+fn planes_reached(planes: &[Plane], centre: &Point3<Real>, radius: Real, tol: Real) -> u64 {
+    planes.iter().enumerate().fold(0, |m, (k, p)| {
+        m | ((p.distance(centre) + radius >= -tol) as u64) << k
+    })
+}
+
+/// Indices of the set bits of `mask`, lowest first.
+#[inline]
+fn bits(mut mask: u64) -> impl Iterator<Item = usize> {
+    std::iter::from_fn(move || {
+        (mask != 0).then(|| {
+            let k = mask.trailing_zeros() as usize;
+            mask &= mask - 1;
+            k
+        })
+    })
+}
+
+/// Clips a face polygon by the planes of `cut`.
+#[inline]
+fn clip_by_planes(poly: &mut FixedPolygon, cut: &FaceCut, planes: &[Plane]) {
+    for k in bits(cut.planes) {
+        poly.clip(&planes[k]);
+        if poly.is_degenerate() {
+            return;
+        }
+    }
+}
+
+/// For each plane `k` in `active`, sets bit `v` of `out[k]` when point `v` lies more
+/// than `tol` outside the plane, and of `on[k]` when it lies within `tol` of it; bits
+/// outside `real` (the set of the real, unpadded points) are cleared, and so are the
+/// masks of the planes not in `active`.
+fn vertex_masks<M: VertexSet>(
+    points: &PointSoa,
+    planes: &[Plane],
+    active: u64,
+    tol: Real,
+    real: M,
+    out: &mut Vec<u128>,
+    on: &mut Vec<u128>,
+) {
+    out.clear();
+    on.clear();
+    out.resize(planes.len(), 0);
+    on.resize(planes.len(), 0);
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
+        // SAFETY: the CPU supports the features the function is compiled for.
+        unsafe { vertex_masks_avx2::<M>(points, planes, active, tol, out, on) };
+    } else {
+        vertex_masks_scalar(points, planes, active, tol, out, on);
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    vertex_masks_scalar(points, planes, active, tol, out, on);
+    let real = real.widen();
+    for m in out.iter_mut().chain(on.iter_mut()) {
+        *m &= real;
+    }
+}
+
+fn vertex_masks_scalar(
+    points: &PointSoa,
+    planes: &[Plane],
+    active: u64,
+    tol: Real,
+    out: &mut [u128],
+    on: &mut [u128],
+) {
+    for k in bits(active) {
+        let p = &planes[k];
+        let (mut o, mut n) = (0u128, 0u128);
+        for v in 0..points.x.len() {
+            let d = p.normal.x * points.x[v] + p.normal.y * points.y[v] + p.normal.z * points.z[v]
+                - p.offset;
+            o |= ((d > tol) as u128) << v;
+            n |= ((d <= tol && d >= -tol) as u128) << v;
+        }
+        out[k] = o;
+        on[k] = n;
+    }
+}
+
+/// [`vertex_masks_scalar`] four points at a time, the masks read off the sign bits.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+unsafe fn vertex_masks_avx2<M: VertexSet>(
+    points: &PointSoa,
+    planes: &[Plane],
+    active: u64,
+    tol: Real,
+    out: &mut [u128],
+    on: &mut [u128],
+) {
+    use std::arch::x86_64::*;
+    let chunks = points.x.len() / 4;
+    let tol_v = _mm256_set1_pd(tol);
+    let neg_tol_v = _mm256_set1_pd(-tol);
+    for k in bits(active) {
+        let p = &planes[k];
+        let (nx, ny, nz, off) = (
+            _mm256_set1_pd(p.normal.x),
+            _mm256_set1_pd(p.normal.y),
+            _mm256_set1_pd(p.normal.z),
+            _mm256_set1_pd(p.offset),
+        );
+        // Chunks from the last, each shifted in below the ones before.
+        let (mut o, mut n) = (M::EMPTY, M::EMPTY);
+        for c in (0..chunks).rev() {
+            // SAFETY: each array holds 4 * chunks values.
+            let (x, y, z) = unsafe {
+                (
+                    _mm256_loadu_pd(points.x.as_ptr().add(4 * c)),
+                    _mm256_loadu_pd(points.y.as_ptr().add(4 * c)),
+                    _mm256_loadu_pd(points.z.as_ptr().add(4 * c)),
+                )
+            };
+            let d = _mm256_fmadd_pd(nz, z, _mm256_fmadd_pd(ny, y, _mm256_fmsub_pd(nx, x, off)));
+            let outside = _mm256_movemask_pd(_mm256_cmp_pd::<_CMP_GT_OQ>(d, tol_v));
+            let on_plane = _mm256_movemask_pd(_mm256_and_pd(
+                _mm256_cmp_pd::<_CMP_LE_OQ>(d, tol_v),
+                _mm256_cmp_pd::<_CMP_GE_OQ>(d, neg_tol_v),
+            ));
+            o = o.shifted_in(outside);
+            n = n.shifted_in(on_plane);
+        }
+        out[k] = o.widen();
+        on[k] = n.widen();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The AVX2 plane test gives the same bits as the scalar one, also for points on
+    /// and near the planes.
+    #[test]
+    fn vector_and_scalar_vertex_masks_agree() {
+        let d = crate::geometry::generators::dodecahedron(1.0).unwrap();
+        let tol = 1e-12;
+        let mut points: Vec<Point3<Real>> = d.vertices().to_vec();
+        for (k, v) in d.vertices().iter().enumerate() {
+            let s = 1.0 + (k as Real - 10.0) * 1e-13;
+            points.push(Point3::from(v.coords * s));
+            points.push(Point3::from(v.coords * (0.5 + 0.1 * k as Real)));
+        }
+        points.truncate(128);
+        let mut soa = PointSoa::default();
+        soa.fill(&points);
+        let n = d.planes().len();
+        let (mut o1, mut n1) = (vec![0; n], vec![0; n]);
+        let (mut o2, mut n2) = (vec![], vec![]);
+        let every = u64::first(n);
+        vertex_masks_scalar(&soa, d.planes(), every, tol, &mut o1, &mut n1);
+        let all = u128::first(points.len());
+        vertex_masks(&soa, d.planes(), every, tol, all, &mut o2, &mut n2);
+        let o1: Vec<u128> = o1.iter().map(|m| m & all).collect();
+        let n1: Vec<u128> = n1.iter().map(|m| m & all).collect();
+        assert_eq!(o1, o2);
+        assert_eq!(n1, n2);
+        assert!(n1.iter().any(|&m| m != 0) && o1.iter().any(|&m| m != 0));
+    }
+}
