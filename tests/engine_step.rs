@@ -303,3 +303,58 @@ fn damped_frictional_collision_never_gains_energy() {
         );
     }
 }
+
+/// Frozen particles (the buried part of a packed bed) keep their pose to the bit and
+/// are no longer integrated, yet still carry a free particle that rests on them: a
+/// sphere dropped onto a frozen one comes to rest on top with the static overlap of
+/// its weight. Two frozen spheres that overlap have no contact, and frozen spheres
+/// do not touch the floor (so the floor carries nothing).
+#[test]
+fn a_frozen_particle_carries_a_free_one_and_never_moves() {
+    let r = 0.005;
+    let mut world = world_with(
+        Shape::Sphere(talus::geometry::Sphere::new(r).unwrap()),
+        0.3,
+        0.5,
+        9.81,
+    );
+    let p = &mut world.particles;
+    let base = Point3::new(0.01, 0.0, r - 1e-4); // overlaps the floor
+    p.push(0, base, UnitQuaternion::identity(), 1);
+    p.push(
+        0,
+        base + Vector3::new(1.9 * r, 0.0, 0.0),
+        UnitQuaternion::identity(),
+        2,
+    );
+    p.push(
+        0,
+        base + Vector3::new(0.0, 0.0, 2.0 * r + 2e-4),
+        UnitQuaternion::identity(),
+        3,
+    );
+    p.freeze(0);
+    p.freeze(1);
+    assert_eq!(p.frozen_count(), 2);
+    let frozen: Vec<_> = (0..2).map(|i| (p.position[i], p.orientation[i])).collect();
+    let mut engine = Engine::new(1e-5);
+    engine.initialise(&mut world);
+    for _ in 0..30_000 {
+        engine.step(&mut world);
+    }
+    let p = &world.particles;
+    for (i, pose) in frozen.iter().enumerate() {
+        assert_eq!((p.position[i], p.orientation[i]), *pose, "frozen {i} moved");
+        assert_eq!(p.velocity[i], Vector3::zeros());
+    }
+    assert!(p.velocity[2].norm() < 1e-5, "{}", p.velocity[2].norm());
+    assert_eq!(engine.contacts, 1, "only the free sphere's contact");
+    assert_eq!(world.walls[0].force, Vector3::zeros());
+    // At rest: the contact carries the weight, with the overlap δ of the sphere–sphere
+    // volume law at that load: small and positive, straight above the frozen one.
+    let m = world.body_types[0].mass;
+    assert!((p.force[2].z).abs() < 1e-6 * m * 9.81, "{}", p.force[2].z);
+    let delta = 2.0 * r - (p.position[2] - p.position[0]).norm();
+    assert!(delta > 0.0 && delta < 0.02 * r, "overlap {delta}");
+    assert!((p.position[2].xy() - base.xy()).norm() < 1e-9);
+}

@@ -177,9 +177,12 @@ impl Engine {
             &mut p.angular_momentum,
         )
             .into_par_iter()
-            .zip((&p.force, &p.torque, &p.body_type))
+            .zip((&p.force, &p.torque, &p.body_type, &p.frozen))
             .with_min_len(PARTICLES_PER_TASK)
-            .for_each(|((x, v, q, l), (f, t, &kind))| {
+            .for_each(|((x, v, q, l), (f, t, &kind, &frozen))| {
+                if frozen {
+                    return;
+                }
                 let kind = &types[kind as usize];
                 *v += f * (0.5 * dt / kind.mass);
                 *x += *v * dt;
@@ -202,9 +205,12 @@ impl Engine {
         let p = &mut world.particles;
         (&mut p.velocity, &mut p.angular_momentum)
             .into_par_iter()
-            .zip((&p.force, &p.torque, &p.body_type))
+            .zip((&p.force, &p.torque, &p.body_type, &p.frozen))
             .with_min_len(PARTICLES_PER_TASK)
-            .for_each(|((v, l), (f, t, &kind))| {
+            .for_each(|((v, l), (f, t, &kind, &frozen))| {
+                if frozen {
+                    return;
+                }
                 *v += f * (0.5 * dt / types[kind as usize].mass);
                 *l += t * (0.5 * dt);
             });
@@ -254,6 +260,7 @@ impl Engine {
 
         // Particle pairs, in parallel over the candidate pairs; each pair's history
         // is replaced by the one its contact leaves (empty when they do not touch).
+        // Two frozen particles push on nothing that moves: their pair is skipped.
         let w = &*world;
         let (radii, laws, dt) = (&self.radii, &self.laws, self.dt);
         let pairs = self.neighbours.pairs();
@@ -266,8 +273,10 @@ impl Engine {
                 .map(|(&[i, j], history)| {
                     let (i, j) = (i as usize, j as usize);
                     let reach = radii[i] + radii[j];
-                    let c = if (w.particles.position[j] - w.particles.position[i]).norm_squared()
-                        < reach * reach
+                    let frozen = &w.particles.frozen;
+                    let c = if !(frozen[i] && frozen[j])
+                        && (w.particles.position[j] - w.particles.position[i]).norm_squared()
+                            < reach * reach
                     {
                         pair_force(w, i, j, *history, laws, dt)
                     } else {
@@ -292,7 +301,9 @@ impl Engine {
             .for_each(|(k, (force, torque, touching))| {
                 *force = gravity * types[p.body_type[k] as usize].mass;
                 *torque = Vector3::zeros();
-                *touching = false;
+                // A frozen particle is part of a bed, whether or not its contacts are
+                // evaluated.
+                *touching = p.frozen[k];
                 for &index in list.incident(k) {
                     let Some(c) = &results[index as usize] else {
                         continue;
@@ -325,7 +336,13 @@ impl Engine {
         let wall_results: Vec<Vec<WallContact>> = (0..w.particles.len())
             .into_par_iter()
             .with_min_len(WALL_PARTICLES_PER_TASK)
-            .map(|i| wall_contacts(w, i, list, wall_history, laws, &law))
+            .map(|i| {
+                if w.particles.frozen[i] {
+                    Vec::new()
+                } else {
+                    wall_contacts(w, i, list, wall_history, laws, &law)
+                }
+            })
             .collect();
         let mut next_wall_history = HashMap::new();
         for (i, list) in wall_results.into_iter().enumerate() {

@@ -49,9 +49,12 @@ pub struct Summary {
     pub wall_clock_s: Real,
     /// Particles at the end.
     pub particles: usize,
+    /// Of them frozen (`[bed] freeze`).
+    pub frozen: usize,
     /// Contacts at the end.
     pub contacts: usize,
-    /// Particle-steps per second of wall-clock time.
+    /// Particle-steps per second of wall-clock time (particles integrated: frozen
+    /// ones do not count).
     pub particle_steps_per_s: Real,
     /// Contact evaluations per second of wall-clock time.
     pub contacts_per_s: Real,
@@ -125,7 +128,7 @@ impl RunOutput {
         let mut series_csv = BufWriter::new(File::create(dir.join("series.csv"))?);
         writeln!(
             series_csv,
-            "time,particles,contacts,kinetic_energy,max_speed"
+            "time,particles,contacts,kinetic_energy,max_speed,frozen"
         )?;
         Ok(RunOutput {
             dir: dir.to_path_buf(),
@@ -234,9 +237,10 @@ impl RunOutput {
         writeln!(self.walls_csv, "{row}")?;
         writeln!(
             self.series_csv,
-            "{t:.9e},{},{contacts},{:.9e},{max_speed:.9e}",
+            "{t:.9e},{},{contacts},{:.9e},{max_speed:.9e},{}",
             world.particles.len(),
-            world.kinetic_energy()
+            world.kinetic_energy(),
+            world.particles.frozen_count()
         )?;
         self.last_row = t;
         self.rows += 1;

@@ -125,6 +125,11 @@ pub(super) fn resolve_bed(spec: &BedSpec) -> Result<Bed, FieldError> {
             format!("{x} must be non-negative"),
         ));
     }
+    if let Some(f) = &spec.freeze {
+        let path = path.key("freeze");
+        positive(path.key("depth"), f.depth)?;
+        positive(path.key("max_speed"), f.max_speed)?;
+    }
     if !(spec.shrink > 0.0 && spec.shrink <= 1.0) {
         return Err(FieldError::new(
             path.key("shrink"),

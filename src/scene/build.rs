@@ -431,9 +431,14 @@ impl<'a> Builder<'a> {
         positive(path.key("rate"), spec.rate)?;
         if let Some(h) = spec.bed_height {
             positive(path.key("bed_height"), h)?;
-            if self.spec.bed.is_none() {
+        }
+        for (key, used) in [
+            ("bed_height", spec.bed_height.is_some()),
+            ("above_bed", spec.above_bed),
+        ] {
+            if used && self.spec.bed.is_none() {
                 return Err(FieldError::new(
-                    path.key("bed_height"),
+                    path.key(key),
                     "needs a [bed] section: the bed height is measured in its tube",
                 ));
             }
@@ -461,6 +466,7 @@ impl<'a> Builder<'a> {
             self.spec.simulation.seed.wrapping_add(1 + k as u64),
         );
         inlet.stop_height = spec.bed_height;
+        inlet.above_bed = spec.above_bed;
         Ok(inlet)
     }
 

@@ -192,6 +192,21 @@ impl Plan {
                 format!("bed analysis: tube of radius {} m", b.radius),
                 "packing.json, profiles, poses.csv, bed.stl at the end ([bed])".into(),
             );
+            if let Some(f) = &b.freeze {
+                line(
+                    format!(
+                        "freezing: particles {} m below the bed height, slower than {} m/s",
+                        f.depth, f.max_speed
+                    ),
+                    "not integrated; no contacts among them or with walls ([bed] freeze)".into(),
+                );
+            }
+        }
+        if inlets.iter().any(|i| i.above_bed) {
+            line(
+                "inlet boxes ride above the bed".into(),
+                "shifted by the bed height every 5 ms (above_bed)".into(),
+            );
         }
         plan.friction = friction;
         plan.polyhedra = n_poly > 0;

@@ -4,7 +4,7 @@
 use nalgebra::Vector3;
 
 use super::Scene;
-use super::spec::SettleSpec;
+use super::spec::{FreezeSpec, SettleSpec};
 use crate::Real;
 use crate::analysis::packing::{Bed, bed_height_of};
 use crate::engine::step::Engine;
@@ -26,13 +26,16 @@ pub struct Simulation {
     pub(super) next_id: u64,
     settle: Option<SettleSpec>,
     pub(super) quiet_since: Option<Real>,
-    /// The bed whose height stops inlets fed "until a bed height".
+    /// The bed whose height stops inlets fed "until a bed height", moves inlets fed
+    /// above it, and below which particles freeze.
     bed: Option<Bed>,
+    freeze: Option<FreezeSpec>,
 }
 
-/// Simulated time between two measurements of the bed height while inlets feed
-/// until a height: a few pellets' worth of feeding at usual rates, and the exact
-/// volume integration it costs stays far below the steps in between.
+/// Simulated time between two measurements of the bed height (while inlets feed
+/// until a height or above the bed, or the bed freezes): a few pellets' worth of
+/// feeding at usual rates, and the exact volume integration it costs stays far below
+/// the steps in between.
 pub const BED_HEIGHT_INTERVAL: Real = 5e-3;
 
 /// Figures of the state after a step.
@@ -66,6 +69,7 @@ impl Simulation {
             settle: scene.spec.simulation.settle.clone(),
             quiet_since: None,
             bed: scene.bed,
+            freeze: scene.spec.bed.as_ref().and_then(|b| b.freeze.clone()),
         };
         sim.insert();
         sim.engine.initialise(&mut sim.world);
@@ -87,7 +91,7 @@ impl Simulation {
         let before = self.world.time;
         self.engine.step(&mut self.world);
         self.steps += 1;
-        self.stop_inlets_at_bed_height(before);
+        self.follow_bed(before);
         self.insert();
         self.update_settling();
     }
@@ -106,13 +110,14 @@ impl Simulation {
         }
     }
 
-    /// Stops the inlets whose bed height is reached, measured once per
-    /// [`BED_HEIGHT_INTERVAL`] of simulated time (at its multiples, so a restored
-    /// run measures when the original did).
-    fn stop_inlets_at_bed_height(&mut self, before: Real) {
+    /// Measures the bed height once per [`BED_HEIGHT_INTERVAL`] of simulated time (at
+    /// its multiples, so a restored run measures when the original did) while
+    /// something depends on it: stops the inlets whose bed height is reached, moves
+    /// those fed above the bed, and freezes the buried particles.
+    fn follow_bed(&mut self, before: Real) {
         let Some(bed) = &self.bed else { return };
-        let feeding = |i: &Inlet| i.stop_height.is_some() && !i.is_done();
-        if !self.inlets.iter().any(feeding)
+        let feeding = |i: &Inlet| (i.stop_height.is_some() || i.above_bed) && !i.is_done();
+        if !(self.freeze.is_some() || self.inlets.iter().any(feeding))
             || (before / BED_HEIGHT_INTERVAL).floor()
                 == (self.world.time / BED_HEIGHT_INTERVAL).floor()
         {
@@ -141,6 +146,14 @@ impl Simulation {
             if inlet.stop_height.is_some_and(|h| height >= h) {
                 inlet.stop();
             }
+            if inlet.above_bed {
+                inlet.offset = bed.tube.axis * height;
+            }
+        }
+        // The pairs of frozen particles drop out of the force loop, not out of the
+        // candidate lists: no rebuild is needed.
+        if let Some(freeze) = &self.freeze {
+            freeze_buried(&mut self.world, bed, freeze, height, &member);
         }
     }
 
@@ -186,4 +199,31 @@ impl Simulation {
             (false, _) => None,
         };
     }
+}
+
+/// Freezes the particles in `member` (the bed) that are slower than the freeze speed
+/// and whose bounding sphere lies wholly more than the freeze depth below `height`;
+/// returns how many froze.
+fn freeze_buried(
+    world: &mut World,
+    bed: &Bed,
+    freeze: &FreezeSpec,
+    height: Real,
+    member: &[bool],
+) -> usize {
+    let (types, p) = (&world.body_types, &mut world.particles);
+    let mut frozen = 0;
+    for i in 0..p.len() {
+        let top = (p.position[i] - bed.tube.base).dot(&bed.tube.axis)
+            + types[p.body_type[i] as usize].shape.circumradius();
+        if member[i]
+            && !p.frozen[i]
+            && top < height - freeze.depth
+            && p.velocity[i].norm() < freeze.max_speed
+        {
+            p.freeze(i);
+            frozen += 1;
+        }
+    }
+    frozen
 }

@@ -69,6 +69,25 @@ pub struct BedSpec {
     /// separates touching particles for CFD meshing).
     #[serde(default = "one")]
     pub shrink: Real,
+    /// Freeze the buried part of the bed while it is fed (see [`FreezeSpec`]).
+    pub freeze: Option<FreezeSpec>,
+}
+
+/// `[bed] freeze`: while the bed is measured (every 5 ms of simulated time), every
+/// particle that touches something, moves slower than `max_speed` and lies wholly
+/// (its bounding sphere) more than `depth` below the bed height is frozen for the
+/// rest of the run: it keeps its pose and is no longer integrated, and its contacts
+/// with other frozen particles and with walls are skipped. A long bed then costs
+/// what its top layer costs. Frozen particles no longer load the walls, so wall
+/// forces leave out the frozen part of the bed.
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct FreezeSpec {
+    /// Depth below the bed height, m: a few particle diameters, deeper than the
+    /// stress from the layers above reaches in a narrow tube (Janssen).
+    pub depth: Real,
+    /// Largest speed of a particle to freeze, m/s.
+    pub max_speed: Real,
 }
 
 fn up() -> [Real; 3] {
@@ -526,4 +545,10 @@ pub struct InletSpec {
     /// down the tube wall), measured every 5 ms of simulated time. `count`
     /// stays the upper limit. Particles in flight when feeding stops still land.
     pub bed_height: Option<Real>,
+    /// Move the insertion box up the `[bed]` axis with the bed: it is shifted by
+    /// the bed height measured every 5 ms (by nothing before there is a bed), so
+    /// particles fall from the same height above the bed surface throughout a long
+    /// fill, as from a loading sock lifted with the bed.
+    #[serde(default)]
+    pub above_bed: bool,
 }

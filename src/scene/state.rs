@@ -1,8 +1,8 @@
 //! The dynamic state of a [`Simulation`] as bytes, and back.
 //!
 //! What is saved is everything that evolves: particles (with this step's forces, which
-//! the next half kick uses), wall poses, velocities and forces, the tangential contact
-//! history, inlet counters and random generators, time, step count and the settling
+//! the next half kick uses, and whether they are frozen), wall poses, velocities and forces, the tangential contact
+//! history, inlet counters, box offsets and random generators, time, step count and the settling
 //! clock. What a scene defines once (materials, shapes, wall meshes and their facet
 //! grids) is not saved: a state is restored into a simulation of the same scene, and a
 //! fingerprint of that scene in the header refuses any other. Restoring and stepping
@@ -20,7 +20,7 @@ use crate::Real;
 use crate::contact::TangentialHistory;
 use crate::engine::step::ContactHistory;
 
-const MAGIC: &[u8; 8] = b"TALUSST2";
+const MAGIC: &[u8; 8] = b"TALUSST3";
 
 /// Why bytes could not be restored as a state.
 #[derive(Debug, Error, PartialEq)]
@@ -200,6 +200,7 @@ impl Simulation {
             w.vec3(&p.angular_momentum[i]);
             w.vec3(&p.force[i]);
             w.vec3(&p.torque[i]);
+            w.u64(p.frozen[i] as u64);
         }
 
         w.u64(world.walls.len() as u64);
@@ -218,6 +219,7 @@ impl Simulation {
         for inlet in &self.inlets {
             w.u64(inlet.inserted as u64);
             w.u64(inlet.count as u64);
+            w.vec3(&inlet.offset);
             w.blob(&inlet.rng_state());
         }
 
@@ -267,7 +269,7 @@ impl Simulation {
         self.engine.contacts = r.u64()? as usize;
         self.engine.elastic_energy = r.f64()?;
 
-        let n = r.count(8 * 24)?;
+        let n = r.count(8 * 25)?;
         let types = self.world.body_types.len() as u64;
         let p = &mut self.world.particles;
         *p = Default::default();
@@ -292,6 +294,15 @@ impl Simulation {
             p.angular_momentum[i] = r.vec3()?;
             p.force[i] = r.vec3()?;
             p.torque[i] = r.vec3()?;
+            p.frozen[i] = match r.u64()? {
+                0 => false,
+                1 => true,
+                x => {
+                    return Err(StateError::Corrupt(format!(
+                        "particle {id} has frozen flag {x}, not 0 or 1"
+                    )));
+                }
+            };
         }
 
         let walls = r.u64()?;
@@ -332,6 +343,7 @@ impl Simulation {
         for inlet in &mut self.inlets {
             inlet.inserted = r.u64()? as usize;
             inlet.count = r.u64()? as usize;
+            inlet.offset = r.vec3()?;
             inlet
                 .set_rng_state(r.blob()?)
                 .map_err(|e| StateError::Corrupt(format!("inlet generator: {e}")))?;

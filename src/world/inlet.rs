@@ -32,6 +32,11 @@ pub struct Inlet {
     pub count: usize,
     /// Bed height at which feeding stops (see [`Inlet::stop`]).
     pub stop_height: Option<Real>,
+    /// Whether the box follows the bed (see [`Inlet::offset`]).
+    pub above_bed: bool,
+    /// Shift of the insertion box, set from outside (the bed height along the bed's
+    /// axis for an inlet fed `above_bed`).
+    pub offset: Vector3<Real>,
     /// Velocity of inserted particles.
     pub velocity: Vector3<Real>,
     /// Start time.
@@ -61,6 +66,8 @@ impl Inlet {
             rate,
             count,
             stop_height: None,
+            above_bed: false,
+            offset: Vector3::zeros(),
             velocity,
             start,
             inserted: 0,
@@ -118,8 +125,8 @@ impl Inlet {
     }
 
     fn free_position(&mut self, world: &World, radius: Real) -> Option<Point3<Real>> {
-        let lo = self.min.coords + Vector3::repeat(radius);
-        let hi = self.max.coords - Vector3::repeat(radius);
+        let lo = self.min.coords + self.offset + Vector3::repeat(radius);
+        let hi = self.max.coords + self.offset - Vector3::repeat(radius);
         for _ in 0..PLACEMENT_ATTEMPTS {
             let x = Point3::from(lo.zip_map(&hi, |a, b| {
                 if b > a {

@@ -110,7 +110,8 @@ fn run_loop(
         let dt = scene.dt;
         let taken = dt.min(remaining);
         sim.engine.dt = taken;
-        particle_steps += sim.world.particles.len() as u64;
+        let p = &sim.world.particles;
+        particle_steps += (p.len() - p.frozen_count()) as u64;
         sim.step();
         sim.engine.dt = dt;
         contact_sum += sim.engine.contacts as u64;
@@ -144,6 +145,7 @@ fn run_loop(
         steps: sim.steps,
         wall_clock_s: elapsed,
         particles: report.particles,
+        frozen: sim.world.particles.frozen_count(),
         contacts: report.contacts,
         particle_steps_per_s: particle_steps as f64 / elapsed.max(1e-9),
         contacts_per_s: contact_sum as f64 / elapsed.max(1e-9),
