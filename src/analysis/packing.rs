@@ -397,6 +397,12 @@ impl<'a> Placed<'a> {
     /// Solid fraction per axial slice over the tube's cross-section, and the bed
     /// height they give.
     fn axial(&self) -> (Vec<Real>, Real) {
+        self.axial_above(0.0)
+    }
+
+    /// [`Self::axial`] over the slices above `from` only (those below read 0, and
+    /// the bodies must include every one that reaches above `from`).
+    fn axial_above(&self, from: Real) -> (Vec<Real>, Real) {
         let slice = self.slice;
         let top = self
             .bodies
@@ -405,9 +411,10 @@ impl<'a> Placed<'a> {
             .fold(0.0, Real::max);
         let slices = (top / slice).ceil().max(1.0) as usize;
         let mut solid = vec![0.0; slices];
+        let lowest = (from.max(0.0) / slice).floor() as usize;
         for b in &self.bodies {
             let (lo, hi) = b.z_range();
-            let first = (lo.max(0.0) / slice).floor() as usize;
+            let first = ((lo.max(0.0) / slice).floor() as usize).max(lowest);
             let last = ((hi / slice).ceil() as usize).min(slices);
             for (k, v) in solid.iter_mut().enumerate().take(last).skip(first) {
                 let z = (k as Real * slice, (k + 1) as Real * slice);
@@ -471,10 +478,39 @@ pub fn bed_figures(world: &World, bed: &Bed) -> Result<(Real, Real), String> {
 
 /// Bed height of the particles that `member` marks: while a bed is fed, those
 /// touching something, so that particles in flight above it do not count.
-pub fn bed_height_of(world: &World, bed: &Bed, member: &[bool]) -> Result<Real, String> {
-    let placed = Placed::new(world, bed, |i| member.get(i) == Some(&true))?;
-    Ok(placed.axial().1)
+///
+/// Given the `last` height measured, only the slices from [`FEED_WINDOW`] diameters
+/// below it up are integrated (the threshold, half the median solid fraction, then
+/// comes from the bulk just below the surface): a measurement costs what the top
+/// layers cost, however long the bed. Without `last`, or with a bed shorter than
+/// the window, it is what [`analyse`] gives.
+pub fn bed_height_of(
+    world: &World,
+    bed: &Bed,
+    member: &[bool],
+    last: Option<Real>,
+) -> Result<Real, String> {
+    let (types, p) = (&world.body_types, &world.particles);
+    let axis = bed.tube.axis.normalize();
+    let diameter = types
+        .iter()
+        .map(|t| 2.0 * t.shape.equivalent_radius())
+        .fold(0.0, Real::max);
+    let from = last.map_or(Real::NEG_INFINITY, |h| h - FEED_WINDOW * diameter);
+    let reaches_window = |i: usize| {
+        (p.position[i] - bed.tube.base).dot(&axis)
+            + types[p.body_type[i] as usize].shape.circumradius()
+            > from
+    };
+    let placed = Placed::new(world, bed, |i| {
+        member.get(i) == Some(&true) && reaches_window(i)
+    })?;
+    Ok(placed.axial_above(from).1)
 }
+
+/// Depth of the part of a bed that [`bed_height_of`] integrates, in particle
+/// diameters below the last height: several layers of bulk under the surface layer.
+pub const FEED_WINDOW: Real = 10.0;
 
 /// Analyses the particles of `world` packed in the bed's tube.
 pub fn analyse(world: &World, bed: &Bed) -> Result<Packing, String> {

@@ -30,6 +30,8 @@ pub struct Simulation {
     /// above it, and below which particles freeze.
     bed: Option<Bed>,
     freeze: Option<FreezeSpec>,
+    /// The bed height last measured while feeding or freezing.
+    pub(super) bed_height: Option<Real>,
 }
 
 /// Simulated time between two measurements of the bed height (while inlets feed
@@ -70,6 +72,7 @@ impl Simulation {
             quiet_since: None,
             bed: scene.bed,
             freeze: scene.spec.bed.as_ref().and_then(|b| b.freeze.clone()),
+            bed_height: None,
         };
         sim.insert();
         sim.engine.initialise(&mut sim.world);
@@ -139,9 +142,10 @@ impl Simulation {
                     && p.velocity[i].norm() < 0.5 * (g * d).sqrt()
             })
             .collect();
-        let Ok(height) = bed_height_of(w, bed, &member) else {
+        let Ok(height) = bed_height_of(w, bed, &member, self.bed_height) else {
             return;
         };
+        self.bed_height = Some(height);
         for inlet in self.inlets.iter_mut().filter(|i| feeding(i)) {
             if inlet.stop_height.is_some_and(|h| height >= h) {
                 inlet.stop();

@@ -2,8 +2,8 @@
 //!
 //! What is saved is everything that evolves: particles (with this step's forces, which
 //! the next half kick uses, and whether they are frozen), wall poses, velocities and forces, the tangential contact
-//! history, inlet counters, box offsets and random generators, time, step count and the settling
-//! clock. What a scene defines once (materials, shapes, wall meshes and their facet
+//! history, inlet counters, box offsets and random generators, time, step count, the settling
+//! clock and the bed height last measured. What a scene defines once (materials, shapes, wall meshes and their facet
 //! grids) is not saved: a state is restored into a simulation of the same scene, and a
 //! fingerprint of that scene in the header refuses any other. Restoring and stepping
 //! on gives the same bits as never having saved.
@@ -186,6 +186,7 @@ impl Simulation {
         w.u64(self.steps);
         w.u64(self.next_id);
         w.f64(self.quiet_since.unwrap_or(Real::NAN));
+        w.f64(self.bed_height.unwrap_or(Real::NAN));
         w.u64(self.engine.contacts as u64);
         w.f64(self.engine.elastic_energy);
 
@@ -266,6 +267,8 @@ impl Simulation {
         self.next_id = r.u64()?;
         let quiet = r.f64()?;
         self.quiet_since = (!quiet.is_nan()).then_some(quiet);
+        let height = r.f64()?;
+        self.bed_height = (!height.is_nan()).then_some(height);
         self.engine.contacts = r.u64()? as usize;
         self.engine.elastic_energy = r.f64()?;
 

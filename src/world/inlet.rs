@@ -107,8 +107,21 @@ impl Inlet {
             .shape
             .circumradius();
         let mut placed = 0;
+        // Only the particles whose bounding spheres reach into the box can be in the
+        // way: found once per call, not once per attempt (a long bed is far below).
+        let (a, b) = self.centre_range(radius);
+        let (lo, hi) = (a.inf(&b), a.sup(&b)); // every centre drawn lies in there
+        let p = &world.particles;
+        let types = &world.body_types;
+        let mut near: Vec<usize> = (0..p.len())
+            .filter(|&k| {
+                let reach = radius + types[p.body_type[k] as usize].shape.circumradius();
+                let x = p.position[k].coords;
+                (x - x.sup(&lo).inf(&hi)).norm_squared() < reach * reach
+            })
+            .collect();
         while self.inserted < due {
-            let Some(position) = self.free_position(world, radius) else {
+            let Some(position) = self.free_position(world, radius, &near) else {
                 break;
             };
             let orientation = random_orientation(&mut self.rng);
@@ -117,6 +130,7 @@ impl Inlet {
                 .push(self.body_type, position, orientation, *next_id);
             let last = world.particles.len() - 1;
             world.particles.velocity[last] = self.velocity;
+            near.push(last);
             *next_id += 1;
             self.inserted += 1;
             placed += 1;
@@ -124,9 +138,23 @@ impl Inlet {
         placed
     }
 
-    fn free_position(&mut self, world: &World, radius: Real) -> Option<Point3<Real>> {
-        let lo = self.min.coords + self.offset + Vector3::repeat(radius);
-        let hi = self.max.coords + self.offset - Vector3::repeat(radius);
+    /// The box the centre of a particle of bounding radius `radius` is drawn from.
+    fn centre_range(&self, radius: Real) -> (Vector3<Real>, Vector3<Real>) {
+        (
+            self.min.coords + self.offset + Vector3::repeat(radius),
+            self.max.coords + self.offset - Vector3::repeat(radius),
+        )
+    }
+
+    /// A random centre in the box whose ball of `radius` is free (see [`is_free`]),
+    /// checking the particles `near` the box.
+    fn free_position(
+        &mut self,
+        world: &World,
+        radius: Real,
+        near: &[usize],
+    ) -> Option<Point3<Real>> {
+        let (lo, hi) = self.centre_range(radius);
         for _ in 0..PLACEMENT_ATTEMPTS {
             let x = Point3::from(lo.zip_map(&hi, |a, b| {
                 if b > a {
@@ -135,7 +163,7 @@ impl Inlet {
                     0.5 * (a + b)
                 }
             }));
-            if is_free(world, &x, radius) {
+            if is_free_of(world, near.iter().copied(), &x, radius) {
                 return Some(x);
             }
         }
@@ -146,8 +174,18 @@ impl Inlet {
 /// Whether a ball at `x` of radius `r` clears every particle's bounding sphere and
 /// every wall facet.
 pub fn is_free(world: &World, x: &Point3<Real>, r: Real) -> bool {
+    is_free_of(world, 0..world.particles.len(), x, r)
+}
+
+/// [`is_free`] against the particles `candidates` only (and every wall facet).
+fn is_free_of(
+    world: &World,
+    candidates: impl Iterator<Item = usize>,
+    x: &Point3<Real>,
+    r: Real,
+) -> bool {
     let p = &world.particles;
-    for k in 0..p.len() {
+    for k in candidates {
         let rk = world.body_types[p.body_type[k] as usize]
             .shape
             .circumradius();
