@@ -225,21 +225,27 @@ fn an_inlet_feeds_until_the_bed_height_is_reached() {
     );
 }
 
-/// A bed height to feed to needs the [bed] whose tube it is measured in.
+/// A bed height to feed to, and a box riding above the bed, need the [bed] whose
+/// tube the bed height is measured in.
 #[test]
-fn feeding_to_a_bed_height_needs_a_bed_section() {
-    let text = scene(0.1)
-        .replace("count = 60", "count = 60\nbed_height = 0.03")
-        .replace(
-            "[bed]\nbase = [0.0, 0.0, 0.0]\nradius = 0.01\nexclude = 0.005\n",
-            "",
+fn feeding_by_the_bed_needs_a_bed_section() {
+    for (line, field) in [
+        ("bed_height = 0.03", "inlet[0].bed_height"),
+        ("above_bed = true", "inlet[0].above_bed"),
+    ] {
+        let text = scene(0.1)
+            .replace("count = 60", &format!("count = 60\n{line}"))
+            .replace(
+                "[bed]\nbase = [0.0, 0.0, 0.0]\nradius = 0.01\nexclude = 0.005\n",
+                "",
+            );
+        let err = talus::scene::Scene::parse(&text, Path::new("bed.toml")).unwrap_err();
+        let message = err.to_string();
+        assert!(
+            message.contains(field) && message.contains("[bed]"),
+            "{message}"
         );
-    let err = talus::scene::Scene::parse(&text, Path::new("bed.toml")).unwrap_err();
-    let message = err.to_string();
-    assert!(
-        message.contains("inlet[0].bed_height") && message.contains("[bed]"),
-        "{message}"
-    );
+    }
 }
 
 /// A particle's position and orientation.
@@ -381,21 +387,4 @@ fn a_bed_fed_from_above_with_its_buried_part_frozen() {
     };
     assert!((h1 - h0).abs() < d, "heights {h1} and {h0}");
     assert!((e1 - e0).abs() < 0.02, "porosities {e1} and {e0}");
-}
-
-/// `above_bed` needs the [bed] whose height moves the box.
-#[test]
-fn an_inlet_above_the_bed_needs_a_bed_section() {
-    let text = scene(0.1)
-        .replace("count = 60", "count = 60\nabove_bed = true")
-        .replace(
-            "[bed]\nbase = [0.0, 0.0, 0.0]\nradius = 0.01\nexclude = 0.005\n",
-            "",
-        );
-    let err = talus::scene::Scene::parse(&text, Path::new("bed.toml")).unwrap_err();
-    let message = err.to_string();
-    assert!(
-        message.contains("inlet[0].above_bed") && message.contains("[bed]"),
-        "{message}"
-    );
 }

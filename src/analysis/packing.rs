@@ -56,6 +56,25 @@ impl Tube {
         );
         Isometry3::from_parts((turn * -self.base.coords).into(), turn)
     }
+
+    /// Height above the base, along the axis, of the top of particle `i`'s bounding
+    /// sphere.
+    pub fn top_of(&self, world: &World, i: usize) -> Real {
+        let p = &world.particles;
+        (p.position[i] - self.base).dot(&self.axis.normalize())
+            + world.body_types[p.body_type[i] as usize]
+                .shape
+                .circumradius()
+    }
+}
+
+/// Volume-equivalent diameter of the largest particle kind of `world`.
+fn largest_diameter(world: &World) -> Real {
+    world
+        .body_types
+        .iter()
+        .map(|t| 2.0 * t.shape.equivalent_radius())
+        .fold(0.0, Real::max)
 }
 
 /// Settings of the analysis (see the module docs); `None` takes the default.
@@ -364,11 +383,7 @@ impl<'a> Placed<'a> {
             axis: tube.axis.normalize(),
             ..*tube
         };
-        let diameter = world
-            .body_types
-            .iter()
-            .map(|t| 2.0 * t.shape.equivalent_radius())
-            .fold(0.0, Real::max);
+        let diameter = largest_diameter(world);
         let bin = options.bin.unwrap_or(diameter / 20.0);
         let slice = options.slice.unwrap_or(diameter / 10.0);
         for (name, v) in [("bin", bin), ("slice", slice)] {
@@ -490,20 +505,11 @@ pub fn bed_height_of(
     member: &[bool],
     last: Option<Real>,
 ) -> Result<Real, String> {
-    let (types, p) = (&world.body_types, &world.particles);
-    let axis = bed.tube.axis.normalize();
-    let diameter = types
-        .iter()
-        .map(|t| 2.0 * t.shape.equivalent_radius())
-        .fold(0.0, Real::max);
-    let from = last.map_or(Real::NEG_INFINITY, |h| h - FEED_WINDOW * diameter);
-    let reaches_window = |i: usize| {
-        (p.position[i] - bed.tube.base).dot(&axis)
-            + types[p.body_type[i] as usize].shape.circumradius()
-            > from
-    };
+    let from = last.map_or(Real::NEG_INFINITY, |h| {
+        h - FEED_WINDOW * largest_diameter(world)
+    });
     let placed = Placed::new(world, bed, |i| {
-        member.get(i) == Some(&true) && reaches_window(i)
+        member.get(i) == Some(&true) && bed.tube.top_of(world, i) > from
     })?;
     Ok(placed.axial_above(from).1)
 }

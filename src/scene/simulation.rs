@@ -206,28 +206,18 @@ impl Simulation {
 }
 
 /// Freezes the particles in `member` (the bed) that are slower than the freeze speed
-/// and whose bounding sphere lies wholly more than the freeze depth below `height`;
-/// returns how many froze.
-fn freeze_buried(
-    world: &mut World,
-    bed: &Bed,
-    freeze: &FreezeSpec,
-    height: Real,
-    member: &[bool],
-) -> usize {
-    let (types, p) = (&world.body_types, &mut world.particles);
-    let mut frozen = 0;
-    for i in 0..p.len() {
-        let top = (p.position[i] - bed.tube.base).dot(&bed.tube.axis)
-            + types[p.body_type[i] as usize].shape.circumradius();
-        if member[i]
-            && !p.frozen[i]
-            && top < height - freeze.depth
-            && p.velocity[i].norm() < freeze.max_speed
-        {
-            p.freeze(i);
-            frozen += 1;
-        }
+/// and whose bounding sphere lies wholly more than the freeze depth below `height`.
+fn freeze_buried(world: &mut World, bed: &Bed, freeze: &FreezeSpec, height: Real, member: &[bool]) {
+    let p = &world.particles;
+    let buried: Vec<usize> = (0..p.len())
+        .filter(|&i| {
+            member[i]
+                && !p.frozen[i]
+                && bed.tube.top_of(world, i) < height - freeze.depth
+                && p.velocity[i].norm() < freeze.max_speed
+        })
+        .collect();
+    for i in buried {
+        world.particles.freeze(i);
     }
-    frozen
 }

@@ -1,10 +1,11 @@
 //! The dynamic state of a [`Simulation`] as bytes, and back.
 //!
 //! What is saved is everything that evolves: particles (with this step's forces, which
-//! the next half kick uses, and whether they are frozen), wall poses, velocities and forces, the tangential contact
-//! history, inlet counters, box offsets and random generators, time, step count, the settling
-//! clock and the bed height last measured. What a scene defines once (materials, shapes, wall meshes and their facet
-//! grids) is not saved: a state is restored into a simulation of the same scene, and a
+//! the next half kick uses, and whether they are frozen), wall poses, velocities and
+//! forces, the tangential contact history, inlet counters, box offsets and random
+//! generators, time, step count, the settling clock and the bed height last measured.
+//! What a scene defines once (materials, shapes, wall meshes and their facet grids) is
+//! not saved: a state is restored into a simulation of the same scene, and a
 //! fingerprint of that scene in the header refuses any other. Restoring and stepping
 //! on gives the same bits as never having saved.
 //!
