@@ -1,5 +1,6 @@
 //! Figures computed from a running simulation for a use case: the rotating drum
-//! (drive torque and power, angle of repose, velocity field, flowing layer).
+//! (drive torque and power, angle of repose, velocity field, flowing layer) and the
+//! packed bed in a tube (bed height, porosity and its profiles, coordination).
 //!
 //! This layer reads the [`crate::world`] and keeps its own accumulators; it never
 //! changes the simulation. [`crate::output`] writes what it computes.
