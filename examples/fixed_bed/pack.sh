@@ -12,6 +12,8 @@ here="$(cd "$(dirname "$0")" && pwd)"
 root="$(cd "$here/../.." && pwd)"
 (cd "$root" && cargo build --release --quiet)
 mkdir -p "$here/runs"
+# The [materials.*] sections of scene.toml, so the spheres stay of the pellets' material.
+materials="$(awk '/^\[materials\./ { on = 1 } /^\[shapes\./ { on = 0 } on' "$here/scene.toml")"
 # name : sphere radius (m) : count
 cases=("spheres_N4:3.125e-3:3000" "spheres_N6:2.0833e-3:3000" "spheres_N10:1.25e-3:3000")
 if [ $# -gt 0 ]; then
@@ -38,19 +40,8 @@ settle = { max_speed = 5e-3, kinetic_energy_per_particle = 1e-9, hold = 0.05 }
 frame_interval = 0.5
 csv_interval = 0.01
 
-[materials.pellet]
-density = 1800.0
-young = 1e6
-poisson = 0.25
-restitution = 0.3
-friction = 0.4
-
-[materials.steel]
-density = 7800.0
-young = 2e11
-poisson = 0.3
-restitution = 0.3
-friction = 0.3
+# The materials of scene.toml:
+$materials
 
 [shapes.ball]
 kind = "sphere"
