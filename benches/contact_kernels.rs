@@ -4,7 +4,8 @@
 //! level, 64 random relative orientations are placed along random directions at the
 //! distance that gives the wanted overlap (as a fraction of one particle's volume,
 //! found by bisection), and each kernel is timed over all of them, best of several
-//! repeats, on one thread.
+//! repeats, on one thread. An argument keeps only the shapes whose name contains it
+//! (`cargo bench --bench contact_kernels -- dodecahedron`).
 
 use std::hint::black_box;
 use std::time::Instant;
@@ -120,6 +121,12 @@ fn main() {
             generators::icosphere(2, 0.005).unwrap(),
         ),
     ];
+    // Cargo passes `--bench` to the harness; any other argument filters the shapes.
+    let filter = std::env::args().skip(1).find(|a| !a.starts_with("--"));
+    let shapes: Vec<(&str, ConvexPolyhedron)> = shapes
+        .into_iter()
+        .filter(|(name, _)| filter.as_ref().is_none_or(|f| name.contains(f.as_str())))
+        .collect();
     let levels: [(&str, f64); 5] = [
         ("near miss (gap 1% R)", -0.01),
         ("shallow 0.2%", 0.002),
