@@ -16,7 +16,7 @@ use crate::contact::{
     tangential_force, twisting_friction,
 };
 use crate::geometry::Shape;
-use crate::geometry::overlap::overlap;
+use crate::geometry::overlap::{OverlapCache, overlap_cached};
 use crate::geometry::sphere::{sphere_polyhedron, sphere_sphere, sphere_triangle};
 use crate::geometry::wall::polyhedron_triangle;
 use crate::world::World;
@@ -82,6 +82,10 @@ pub struct Engine {
     pub neighbours: NeighbourList,
     /// Tangential history of each candidate pair, aligned with the pair list.
     history: Vec<TangentialHistory>,
+    /// What each candidate pair's exact overlap decided at some pose, aligned with
+    /// the pair list: it changes the cost, never the answer (see [`OverlapCache`]), so
+    /// it is neither saved nor carried over a list build.
+    overlap_plans: Vec<OverlapCache>,
     /// History set from outside, to be matched to the pairs at the next list build.
     pending_history: Option<HashMap<(u64, u64), TangentialHistory>>,
     /// Bounding radius of every particle, and the pair results of the last step
@@ -107,6 +111,7 @@ impl Engine {
             regularisation_length: REGULARISATION_LENGTH,
             neighbours: NeighbourList::default(),
             history: Vec::new(),
+            overlap_plans: Vec::new(),
             pending_history: None,
             radii: Vec::new(),
             results: Vec::new(),
@@ -237,6 +242,9 @@ impl Engine {
         };
         self.neighbours.build(world, &self.radii);
         let list = &self.neighbours;
+        self.overlap_plans.clear();
+        self.overlap_plans
+            .resize(list.pairs().len(), OverlapCache::default());
         self.history.clear();
         self.history.extend(list.pairs().iter().map(|&pair| {
             carried
@@ -269,8 +277,9 @@ impl Engine {
             pairs
                 .par_iter()
                 .zip(&mut self.history)
+                .zip(&mut self.overlap_plans)
                 .with_min_len(PAIRS_PER_TASK)
-                .map(|(&[i, j], history)| {
+                .map(|((&[i, j], history), plan)| {
                     let (i, j) = (i as usize, j as usize);
                     let reach = radii[i] + radii[j];
                     let frozen = &w.particles.frozen;
@@ -278,7 +287,7 @@ impl Engine {
                         && (w.particles.position[j] - w.particles.position[i]).norm_squared()
                             < reach * reach
                     {
-                        pair_force(w, i, j, *history, laws, dt)
+                        pair_force(w, i, j, *history, plan, laws, dt)
                     } else {
                         None
                     };
@@ -426,8 +435,14 @@ fn velocity_at(
     world.particles.velocity[i] + angular_velocity.cross(&(point - world.particles.position[i]))
 }
 
-/// Contact geometry of particles `i` and `j` in world coordinates (normal i → j).
-fn pair_geometry(world: &World, i: usize, j: usize) -> Option<ContactGeometry> {
+/// Contact geometry of particles `i` and `j` in world coordinates (normal i → j);
+/// `plan` is the pair's kept overlap plan.
+fn pair_geometry(
+    world: &World,
+    i: usize,
+    j: usize,
+    plan: &mut OverlapCache,
+) -> Option<ContactGeometry> {
     let p = &world.particles;
     let (si, sj) = (
         &world.body_types[p.body_type[i] as usize].shape,
@@ -438,7 +453,7 @@ fn pair_geometry(world: &World, i: usize, j: usize) -> Option<ContactGeometry> {
     match (si, sj) {
         (Shape::Polyhedron(a), Shape::Polyhedron(b)) => {
             let (pi, pj) = (pose(i), pose(j));
-            let o = overlap(a, b, &(pi.inverse() * pj))?;
+            let o = overlap_cached(a, b, &(pi.inverse() * pj), plan)?;
             Some(ContactGeometry {
                 volume: o.volume,
                 area: o.area,
@@ -474,7 +489,7 @@ fn pair_geometry(world: &World, i: usize, j: usize) -> Option<ContactGeometry> {
         (Shape::Sphere(_), Shape::Polyhedron(_)) => {
             // Body 2 here is the polyhedron's partner sphere: the cap model's point lies
             // on the line through the sphere's centre, so it carries no torque model.
-            let mut g = pair_geometry(world, j, i)?;
+            let mut g = pair_geometry(world, j, i, plan)?;
             g.normal = -g.normal;
             g.rotation_gradient = None;
             Some(g)
@@ -583,10 +598,11 @@ fn pair_force(
     i: usize,
     j: usize,
     history: TangentialHistory,
+    plan: &mut OverlapCache,
     laws: &ContactLaws,
     dt: Real,
 ) -> Option<ContactForce> {
-    let g = pair_geometry(world, i, j)?;
+    let g = pair_geometry(world, i, j, plan)?;
     let p = &world.particles;
     let law = laws.pair(p.body_type[i], p.body_type[j]);
     let (wi, wj) = (world.angular_velocity(i), world.angular_velocity(j));

@@ -16,6 +16,9 @@
 //!
 //! The masks of one plane are computed four vertices at a time (AVX2 where the CPU
 //! has it); the face decisions cost a few integer operations per face and plane.
+//! They are made once into a [`FacePlan`], with the margin by which the closest
+//! vertex–plane test missed its threshold, and carried out by [`overlap_planned`]:
+//! a pair whose plan still holds skips straight to the clipping.
 
 use std::ops::{BitAnd, BitOr, Not};
 
@@ -27,37 +30,65 @@ use crate::geometry::plane::PointSoa;
 use crate::geometry::polygon::FixedPolygon;
 use crate::geometry::{ConvexPolyhedron, Plane};
 
-/// The overlap of `a` and `b` (B's vertices and planes already in A's frame in `s`;
-/// `t` is B's centroid in A's frame).
-pub(super) fn overlap_masked(
+/// A face of one shape that bounds the intersection, with the planes of the other
+/// shape to clip it by.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(super) struct PlannedFace {
+    planes: u64,
+    face: u8,
+    /// The face lies in a plane of the other shape of equal orientation (A's faces
+    /// only; such faces of B are left out, A's face covers them).
+    flush: bool,
+}
+
+/// Every discrete decision of the masked path at one relative pose: whether a plane
+/// separates the shapes, and which faces of A, then of B, bound the intersection,
+/// each with the planes that cut it.
+#[derive(Clone, Debug, Default)]
+pub(super) struct FacePlan {
+    pub(super) separated: bool,
+    /// Faces of A (the first `of_a`), then faces of B.
+    pub(super) faces: Vec<PlannedFace>,
+    pub(super) of_a: usize,
+    /// Smallest distance by which a vertex–plane or bounding-ball–plane test missed
+    /// its thresholds: while no vertex of either shape moves this far relative to the
+    /// other's planes, every decision comes out the same.
+    pub(super) margin: Real,
+}
+
+/// Plans the overlap of `a` and `b` into `s.plan` (B's vertices and planes already in
+/// A's frame in `s`; `t` is B's centroid in A's frame).
+pub(super) fn plan_masked(
     a: &ConvexPolyhedron,
     b: &ConvexPolyhedron,
     t: &Vector3<Real>,
     s: &mut OverlapScratch,
-) -> Option<OverlapGeometry> {
+) {
     // Most shapes have at most 64 vertices: their sets take half the operations.
     if a.vertices().len() <= 64 && b.vertices().len() <= 64 {
-        overlap_with_sets::<u64>(a, b, t, s)
+        plan_with_sets::<u64>(a, b, t, s)
     } else {
-        overlap_with_sets::<u128>(a, b, t, s)
+        plan_with_sets::<u128>(a, b, t, s)
     }
 }
 
-/// [`overlap_masked`] with vertex sets of type `M`.
-fn overlap_with_sets<M: VertexSet>(
+/// [`plan_masked`] with vertex sets of type `M`.
+fn plan_with_sets<M: VertexSet>(
     a: &ConvexPolyhedron,
     b: &ConvexPolyhedron,
     t: &Vector3<Real>,
     s: &mut OverlapScratch,
-) -> Option<OverlapGeometry> {
+) {
     let tol = tolerance(a, b);
     // Planes that hold the other shape's bounding sphere wholly inside can neither
     // cut nor separate; about half of each shape's planes face away from the other.
-    let reached_a = planes_reached(a.planes(), &Point3::from(*t), b.circumradius(), tol);
-    let reached_b = planes_reached(&s.b_planes, &Point3::origin(), a.circumradius(), tol);
+    let (reached_a, margin_a) =
+        planes_reached(a.planes(), &Point3::from(*t), b.circumradius(), tol);
+    let (reached_b, margin_b) =
+        planes_reached(&s.b_planes, &Point3::origin(), a.circumradius(), tol);
     let (all_a, all_b) = (M::first(a.vertices().len()), M::first(b.vertices().len()));
     let (out_a, on_a) = (&mut s.out_a, &mut s.on_a);
-    vertex_masks(
+    let masks_a = vertex_masks(
         a.vertex_soa(),
         &s.b_planes,
         reached_b,
@@ -67,7 +98,7 @@ fn overlap_with_sets<M: VertexSet>(
         on_a,
     );
     let (out_b, on_b) = (&mut s.out_b, &mut s.on_b);
-    vertex_masks(
+    let masks_b = vertex_masks(
         &s.b_point_soa,
         a.planes(),
         reached_a,
@@ -76,39 +107,73 @@ fn overlap_with_sets<M: VertexSet>(
         out_b,
         on_b,
     );
+    let plan = &mut s.plan;
+    plan.margin = margin_a.min(margin_b).min(masks_a).min(masks_b);
+    plan.faces.clear();
+    plan.of_a = 0;
     let side_a = MaskedSide::<M>::new(a, a.planes(), reached_a, &s.out_a, &s.on_a);
     let side_b = MaskedSide::<M>::new(b, &s.b_planes, reached_b, &s.out_b, &s.on_b);
-    if side_a.separated() || side_b.separated() {
-        return None;
+    plan.separated = side_a.separated() || side_b.separated();
+    if plan.separated {
+        return;
     }
-
     // Faces of A clipped by B; flush pieces are kept apart.
-    let mut pieces = Pieces::default();
     for f in bits(reached_a) {
-        let Some(cut) = face_cut(&side_a, &side_b, f) else {
-            continue;
-        };
-        s.fixed
-            .set(a.face(f).iter().map(|&v| a.vertices()[v as usize]));
-        clip_by_planes(&mut s.fixed, &cut, &s.b_planes);
-        if !s.fixed.is_degenerate() {
-            let normal = a.planes()[f].normal;
-            pieces.add(s.fixed.points(), &normal, false, cut.flush, &mut s.points);
+        if let Some(cut) = face_cut(&side_a, &side_b, f) {
+            plan.faces.push(PlannedFace {
+                planes: cut.planes,
+                face: f as u8,
+                flush: cut.flush,
+            });
         }
     }
-
+    plan.of_a = plan.faces.len();
     // Faces of B clipped by A; a face lying in a plane of A of equal orientation is
     // already covered by A's face.
     for g in bits(reached_b) {
-        let Some(cut) = face_cut(&side_b, &side_a, g) else {
-            continue;
-        };
-        if cut.flush {
-            continue;
+        if let Some(cut) = face_cut(&side_b, &side_a, g).filter(|cut| !cut.flush) {
+            plan.faces.push(PlannedFace {
+                planes: cut.planes,
+                face: g as u8,
+                flush: false,
+            });
         }
+    }
+}
+
+/// The overlap by a plan: `faces_a` clipped by B's planes and `faces_b` by A's (B's
+/// vertices and planes already in A's frame in `s`; `t` is B's centroid in A's
+/// frame).
+pub(super) fn overlap_planned(
+    a: &ConvexPolyhedron,
+    b: &ConvexPolyhedron,
+    t: &Vector3<Real>,
+    faces_a: &[PlannedFace],
+    faces_b: &[PlannedFace],
+    s: &mut OverlapScratch,
+) -> Option<OverlapGeometry> {
+    let mut pieces = Pieces::default();
+    for planned in faces_a {
+        let f = planned.face as usize;
+        s.fixed
+            .set(a.face(f).iter().map(|&v| a.vertices()[v as usize]));
+        clip_by_planes(&mut s.fixed, planned.planes, &s.b_planes);
+        if !s.fixed.is_degenerate() {
+            let normal = a.planes()[f].normal;
+            pieces.add(
+                s.fixed.points(),
+                &normal,
+                false,
+                planned.flush,
+                &mut s.points,
+            );
+        }
+    }
+    for planned in faces_b {
+        let g = planned.face as usize;
         s.fixed
             .set(b.face(g).iter().map(|&v| s.b_points[v as usize]));
-        clip_by_planes(&mut s.fixed, &cut, a.planes());
+        clip_by_planes(&mut s.fixed, planned.planes, a.planes());
         if !s.fixed.is_degenerate() {
             let normal = s.b_planes[g].normal;
             pieces.add(s.fixed.points(), &normal, true, false, &mut s.points);
@@ -256,11 +321,16 @@ fn face_cut<M: VertexSet>(own: &MaskedSide<M>, other: &MaskedSide<M>, f: usize) 
     Some(cut)
 }
 
-/// Planes (bits) whose outside the ball (`centre`, `radius`) reaches to within `tol`.
-fn planes_reached(planes: &[Plane], centre: &Point3<Real>, radius: Real, tol: Real) -> u64 {
-    planes.iter().enumerate().fold(0, |m, (k, p)| {
-        m | ((p.distance(centre) + radius >= -tol) as u64) << k
-    })
+/// Planes (bits) whose outside the ball (`centre`, `radius`) reaches to within `tol`,
+/// and by how much the closest call missed the threshold.
+fn planes_reached(planes: &[Plane], centre: &Point3<Real>, radius: Real, tol: Real) -> (u64, Real) {
+    planes
+        .iter()
+        .enumerate()
+        .fold((0, Real::INFINITY), |(m, margin), (k, p)| {
+            let reach = p.distance(centre) + radius + tol;
+            (m | ((reach >= 0.0) as u64) << k, margin.min(reach.abs()))
+        })
 }
 
 /// Indices of the set bits of `mask`, lowest first.
@@ -275,10 +345,10 @@ fn bits(mut mask: u64) -> impl Iterator<Item = usize> {
     })
 }
 
-/// Clips a face polygon by the planes of `cut`.
+/// Clips a face polygon by the planes (bits) `cut`.
 #[inline]
-fn clip_by_planes(poly: &mut FixedPolygon, cut: &FaceCut, planes: &[Plane]) {
-    for k in bits(cut.planes) {
+fn clip_by_planes(poly: &mut FixedPolygon, cut: u64, planes: &[Plane]) {
+    for k in bits(cut) {
         poly.clip(&planes[k]);
         if poly.is_degenerate() {
             return;
@@ -289,7 +359,9 @@ fn clip_by_planes(poly: &mut FixedPolygon, cut: &FaceCut, planes: &[Plane]) {
 /// For each plane `k` in `active`, sets bit `v` of `out[k]` when point `v` lies more
 /// than `tol` outside the plane, and of `on[k]` when it lies within `tol` of it; bits
 /// outside `real` (the set of the real, unpadded points) are cleared, and so are the
-/// masks of the planes not in `active`.
+/// masks of the planes not in `active`. Returns the smallest `||d| − tol|` over the
+/// distances `d` tested (padding included): how far the closest call was from going
+/// the other way.
 fn vertex_masks<M: VertexSet>(
     points: &PointSoa,
     planes: &[Plane],
@@ -298,24 +370,27 @@ fn vertex_masks<M: VertexSet>(
     real: M,
     out: &mut Vec<u128>,
     on: &mut Vec<u128>,
-) {
+) -> Real {
     out.clear();
     on.clear();
     out.resize(planes.len(), 0);
     on.resize(planes.len(), 0);
     #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
+    let margin = if std::arch::is_x86_feature_detected!("avx2")
+        && std::arch::is_x86_feature_detected!("fma")
+    {
         // SAFETY: the CPU supports the features the function is compiled for.
-        unsafe { vertex_masks_avx2::<M>(points, planes, active, tol, out, on) };
+        unsafe { vertex_masks_avx2::<M>(points, planes, active, tol, out, on) }
     } else {
-        vertex_masks_scalar(points, planes, active, tol, out, on);
-    }
+        vertex_masks_scalar(points, planes, active, tol, out, on)
+    };
     #[cfg(not(target_arch = "x86_64"))]
-    vertex_masks_scalar(points, planes, active, tol, out, on);
+    let margin = vertex_masks_scalar(points, planes, active, tol, out, on);
     let real = real.widen();
     for m in out.iter_mut().chain(on.iter_mut()) {
         *m &= real;
     }
+    margin
 }
 
 fn vertex_masks_scalar(
@@ -325,7 +400,8 @@ fn vertex_masks_scalar(
     tol: Real,
     out: &mut [u128],
     on: &mut [u128],
-) {
+) -> Real {
+    let mut margin = Real::INFINITY;
     for k in bits(active) {
         let p = &planes[k];
         let (mut o, mut n) = (0u128, 0u128);
@@ -334,10 +410,12 @@ fn vertex_masks_scalar(
                 - p.offset;
             o |= ((d > tol) as u128) << v;
             n |= ((d <= tol && d >= -tol) as u128) << v;
+            margin = margin.min((d.abs() - tol).abs());
         }
         out[k] = o;
         on[k] = n;
     }
+    margin
 }
 
 /// [`vertex_masks_scalar`] four points at a time, the masks read off the sign bits.
@@ -350,11 +428,13 @@ unsafe fn vertex_masks_avx2<M: VertexSet>(
     tol: Real,
     out: &mut [u128],
     on: &mut [u128],
-) {
+) -> Real {
     use std::arch::x86_64::*;
     let chunks = points.x.len() / 4;
     let tol_v = _mm256_set1_pd(tol);
     let neg_tol_v = _mm256_set1_pd(-tol);
+    let sign = _mm256_set1_pd(-0.0);
+    let mut margin = _mm256_set1_pd(Real::INFINITY);
     for k in bits(active) {
         let p = &planes[k];
         let (nx, ny, nz, off) = (
@@ -382,10 +462,16 @@ unsafe fn vertex_masks_avx2<M: VertexSet>(
             ));
             o = o.shifted_in(outside);
             n = n.shifted_in(on_plane);
+            let miss = _mm256_sub_pd(_mm256_andnot_pd(sign, d), tol_v);
+            margin = _mm256_min_pd(margin, _mm256_andnot_pd(sign, miss));
         }
         out[k] = o.widen();
         on[k] = n.widen();
     }
+    let mut lanes = [0.0; 4];
+    // SAFETY: `lanes` holds four values.
+    unsafe { _mm256_storeu_pd(lanes.as_mut_ptr(), margin) };
+    lanes.into_iter().fold(Real::INFINITY, Real::min)
 }
 
 #[cfg(test)]

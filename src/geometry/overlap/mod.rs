@@ -36,6 +36,12 @@
 //! vertex set then reject the face, list the planes that cut it, and detect a
 //! separating face plane.
 //!
+//! The bit-mask path separates deciding (which faces bound the intersection, and
+//! which planes cut each) from clipping. A pair evaluated step after step keeps its
+//! decisions in an [`OverlapCache`] with the distance by which the closest test
+//! missed; until the pair has moved that far, the decisions cannot change and only
+//! the clipping is done again ([`overlap_cached`]), with the same answer bit for bit.
+//!
 //! For larger meshes (icospheres of hundreds to tens of thousands of facets) only faces
 //! whose bounding spheres meet the box `R` enclosing both bounding spheres take part,
 //! after clipping to `R`. This is exact when the shapes intersect (B ∩ R is bounded by
@@ -47,7 +53,7 @@ mod masked;
 
 use std::cell::RefCell;
 
-use nalgebra::{Point3, Vector3};
+use nalgebra::{Matrix3, Point3, Vector3};
 
 use super::plane::{PlaneSoa, PointSoa};
 use super::polygon::{FixedPolygon, SurfaceSums};
@@ -120,6 +126,8 @@ pub struct OverlapScratch {
     sorted: Vec<(Real, u32)>,
     cutting: Vec<u32>,
     fixed: Box<FixedPolygon>,
+    /// The decisions of the masked path at the current pose.
+    plan: masked::FacePlan,
     poly: Vec<Point3<Real>>,
     poly_tmp: Vec<Point3<Real>>,
     dist: Vec<Real>,
@@ -151,8 +159,176 @@ pub fn overlap_with(
     if t.norm() >= a.circumradius() + b.circumradius() {
         return None;
     }
+    place_b(b, b_in_a, s);
+    if maskable(a) && maskable(b) {
+        s.b_point_soa.fill(&s.b_points);
+        masked::plan_masked(a, b, &t, s);
+        overlap_by_plan(a, b, &t, s)
+    } else {
+        culled::overlap_culled(a, b, b_in_a, s)
+    }
+}
+
+/// What the overlap of one pair decided at some pose, kept between steps: the faces
+/// that bound the intersection and the planes that cut each, and how far the pair
+/// may move from that pose before any of these decisions could change.
+///
+/// # Invariant
+/// While B's vertices in A's frame, and A's vertices in B's frame, have moved less
+/// than `margin` since `rotation`/`translation`, every vertex–plane and ball–plane
+/// test of the bit-mask path comes out as it did there, so the kept plan *is* the
+/// plan of the current pose: [`overlap_cached`] then answers bit for bit what
+/// [`overlap`] answers, skipping only the tests. Shapes beyond the bit-mask path,
+/// and plans of more faces than fit, are not kept.
+#[derive(Clone, Debug)]
+pub struct OverlapCache {
+    rotation: Matrix3<Real>,
+    translation: Vector3<Real>,
+    /// Negative: nothing kept.
+    margin: Real,
+    separated: bool,
+    faces: [masked::PlannedFace; CACHED_FACES],
+    of_a: u8,
+    len: u8,
+}
+
+/// Most planned faces (of both shapes together) an [`OverlapCache`] keeps: a shallow
+/// contact of dodecahedra has about five.
+const CACHED_FACES: usize = 12;
+
+impl Default for OverlapCache {
+    fn default() -> Self {
+        OverlapCache {
+            rotation: Matrix3::identity(),
+            translation: Vector3::zeros(),
+            margin: -1.0,
+            separated: false,
+            faces: [masked::PlannedFace::default(); CACHED_FACES],
+            of_a: 0,
+            len: 0,
+        }
+    }
+}
+
+impl OverlapCache {
+    /// Whether the kept plan still holds at the pose (`rotation`, `translation`) of
+    /// B in A, for shapes of circumradii `ra` and `rb`.
+    ///
+    /// A vertex w of B moves in A's frame by at most `|Δt| + ‖ΔR‖ |w|`, and a vertex v
+    /// of A moves in B's frame by at most `|Δt| + ‖ΔR‖ (|v| + |t₀|)`, so neither moves
+    /// more than `|Δt| + ‖ΔR‖ (max(ra, rb) + |t₀|)` relative to the other's planes
+    /// (and the ball–plane tests move less). For rotations the spectral norm `‖ΔR‖`
+    /// is the Frobenius norm over √2. A plane–normal sign test between flush faces
+    /// (the only other decision) cannot flip without a turn of order one radian, far
+    /// beyond any margin.
+    fn holds(
+        &self,
+        rotation: &Matrix3<Real>,
+        translation: &Vector3<Real>,
+        ra: Real,
+        rb: Real,
+    ) -> bool {
+        if self.margin <= 0.0 {
+            return false;
+        }
+        let turn = (rotation - self.rotation).norm() * std::f64::consts::FRAC_1_SQRT_2;
+        let drift =
+            (translation - self.translation).norm() + turn * (ra.max(rb) + self.translation.norm());
+        drift < self.margin
+    }
+
+    /// Keeps the plan in `s` for the pose (`rotation`, `translation`), if it fits.
+    fn keep(
+        &mut self,
+        plan: &masked::FacePlan,
+        rotation: Matrix3<Real>,
+        translation: Vector3<Real>,
+        tol: Real,
+    ) {
+        self.margin = -1.0;
+        if plan.faces.len() > CACHED_FACES {
+            return;
+        }
+        self.rotation = rotation;
+        self.translation = translation;
+        self.separated = plan.separated;
+        self.faces[..plan.faces.len()].copy_from_slice(&plan.faces);
+        self.of_a = plan.of_a as u8;
+        self.len = plan.faces.len() as u8;
+        // A distance at the new pose carries round-off well below the tolerance.
+        self.margin = plan.margin - tol;
+    }
+}
+
+/// [`overlap`] for a pair whose overlap is evaluated step after step: the plan of
+/// `cache` is used while it holds (see [`OverlapCache`]) and renewed when it does
+/// not. Bit for bit the answer of [`overlap`].
+pub fn overlap_cached(
+    a: &ConvexPolyhedron,
+    b: &ConvexPolyhedron,
+    b_in_a: &Pose,
+    cache: &mut OverlapCache,
+) -> Option<OverlapGeometry> {
+    SCRATCH.with(|s| overlap_cached_with(a, b, b_in_a, cache, &mut s.borrow_mut()))
+}
+
+/// [`overlap_cached`] with caller-owned scratch buffers.
+pub fn overlap_cached_with(
+    a: &ConvexPolyhedron,
+    b: &ConvexPolyhedron,
+    b_in_a: &Pose,
+    cache: &mut OverlapCache,
+    s: &mut OverlapScratch,
+) -> Option<OverlapGeometry> {
+    let t = b_in_a.translation.vector;
+    if t.norm() >= a.circumradius() + b.circumradius() {
+        return None;
+    }
+    if !(maskable(a) && maskable(b)) {
+        return overlap_with(a, b, b_in_a, s);
+    }
+    let rotation = place_b(b, b_in_a, s);
+    if cache.holds(&rotation, &t, a.circumradius(), b.circumradius()) {
+        if cache.separated {
+            return None;
+        }
+        let (of_a, len) = (cache.of_a as usize, cache.len as usize);
+        return masked::overlap_planned(a, b, &t, &cache.faces[..of_a], &cache.faces[of_a..len], s);
+    }
+    s.b_point_soa.fill(&s.b_points);
+    masked::plan_masked(a, b, &t, s);
+    cache.keep(&s.plan, rotation, t, tolerance(a, b));
+    overlap_by_plan(a, b, &t, s)
+}
+
+/// The overlap by the plan in `s`.
+fn overlap_by_plan(
+    a: &ConvexPolyhedron,
+    b: &ConvexPolyhedron,
+    t: &Vector3<Real>,
+    s: &mut OverlapScratch,
+) -> Option<OverlapGeometry> {
+    if s.plan.separated {
+        return None;
+    }
+    let plan = std::mem::take(&mut s.plan);
+    let (faces_a, faces_b) = plan.faces.split_at(plan.of_a);
+    let overlap = masked::overlap_planned(a, b, t, faces_a, faces_b, s);
+    s.plan = plan;
+    overlap
+}
+
+/// Whether a shape takes the bit-mask path.
+fn maskable(p: &ConvexPolyhedron) -> bool {
+    p.face_count() <= MASK_MAX_FACES && p.vertices().len() <= MASK_MAX_VERTICES
+}
+
+/// Puts B's vertices and planes into A's frame in `s` (and clears the piece
+/// vertices); returns B's rotation in A as a matrix.
+fn place_b(b: &ConvexPolyhedron, b_in_a: &Pose, s: &mut OverlapScratch) -> Matrix3<Real> {
+    let t = b_in_a.translation.vector;
     // A rotation matrix transforms points in half the work of a quaternion.
-    let rot = b_in_a.rotation.to_rotation_matrix();
+    let rot = b_in_a.rotation.to_rotation_matrix().into_inner();
     s.b_points.clear();
     s.b_points.extend(
         b.vertices()
@@ -168,15 +344,7 @@ pub fn overlap_with(
         }
     }));
     s.points.clear();
-    let maskable = |p: &ConvexPolyhedron| {
-        p.face_count() <= MASK_MAX_FACES && p.vertices().len() <= MASK_MAX_VERTICES
-    };
-    if maskable(a) && maskable(b) {
-        s.b_point_soa.fill(&s.b_points);
-        masked::overlap_masked(a, b, &t, s)
-    } else {
-        culled::overlap_culled(a, b, b_in_a, s)
-    }
+    rot
 }
 
 /// Coplanarity tolerance on plane distances.
@@ -273,3 +441,6 @@ fn summarise(
         rotation_gradient_b: b.moment + a.flush_moment - t.cross(&s_b),
     })
 }
+
+#[cfg(test)]
+mod cache_tests;

@@ -1,0 +1,118 @@
+//! A kept overlap plan answers bit for bit what a fresh overlap answers, along paths
+//! of small random motions through touching, overlapping and separated poses, and it
+//! is really kept for most steps of a slow path.
+
+use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
+use rand::{Rng, SeedableRng};
+use rand_pcg::Pcg64;
+
+use super::{OverlapCache, OverlapGeometry, overlap, overlap_cached};
+use crate::Real;
+use crate::geometry::{ConvexPolyhedron, generators};
+
+fn bits(o: &Option<OverlapGeometry>) -> Option<Vec<u64>> {
+    o.map(|o| {
+        [
+            o.volume,
+            o.area,
+            o.depth,
+            o.centroid.x,
+            o.centroid.y,
+            o.centroid.z,
+            o.normal.x,
+            o.normal.y,
+            o.normal.z,
+            o.rotation_gradient_a.x,
+            o.rotation_gradient_a.y,
+            o.rotation_gradient_a.z,
+            o.rotation_gradient_b.x,
+            o.rotation_gradient_b.y,
+            o.rotation_gradient_b.z,
+        ]
+        .map(Real::to_bits)
+        .to_vec()
+    })
+}
+
+fn small_vector(rng: &mut Pcg64, size: Real) -> Vector3<Real> {
+    Vector3::new(
+        rng.random_range(-1.0..1.0),
+        rng.random_range(-1.0..1.0),
+        rng.random_range(-1.0..1.0),
+    ) * size
+}
+
+/// Walks B about A from a shallow overlap along `direction`, with steps of `step`
+/// metres and `turn` radians and now and then a jump; returns (kept, renewed,
+/// overlapping) step counts after checking every step bit for bit.
+fn walk(
+    a: &ConvexPolyhedron,
+    b: &ConvexPolyhedron,
+    seed: u64,
+    step: Real,
+    turn: Real,
+) -> [usize; 3] {
+    let mut rng = Pcg64::seed_from_u64(seed);
+    let reach = a.circumradius() + b.circumradius();
+    let direction = small_vector(&mut rng, 1.0).normalize();
+    let mut rotation = UnitQuaternion::from_scaled_axis(small_vector(&mut rng, 3.0));
+    let mut translation = direction * 0.8 * reach;
+    let mut cache = OverlapCache::default();
+    let mut counts = [0; 3];
+    for k in 0..3000 {
+        if k % 500 == 499 {
+            // A jump: the plan must be renewed, not trusted.
+            translation += small_vector(&mut rng, 0.05 * reach);
+        }
+        // Drift outwards and back so that the pair separates and meets again.
+        let breathe = if (k / 1000) % 2 == 0 { 1.0 } else { -1.0 };
+        translation += small_vector(&mut rng, step) + direction * (breathe * 0.3 * step);
+        rotation = UnitQuaternion::from_scaled_axis(small_vector(&mut rng, turn)) * rotation;
+        let pose = Isometry3::from_parts(Translation3::from(translation), rotation);
+        let kept_before = (cache.translation, cache.margin);
+        let cached = overlap_cached(a, b, &pose, &mut cache);
+        let fresh = overlap(a, b, &pose);
+        assert_eq!(bits(&cached), bits(&fresh), "step {k}");
+        let kept = kept_before == (cache.translation, cache.margin) && cache.margin > 0.0;
+        counts[if kept { 0 } else { 1 }] += 1;
+        counts[2] += fresh.is_some() as usize;
+    }
+    counts
+}
+
+#[test]
+fn kept_plans_answer_bit_for_bit() {
+    let dodecahedron = generators::dodecahedron(0.005).unwrap();
+    let prism = generators::prism(20, 5.5e-3, 5.5e-3).unwrap();
+    let cube = generators::cuboid(0.01, 0.01, 0.01).unwrap();
+    for (name, shape) in [("dodecahedron", &dodecahedron), ("prism", &prism)] {
+        for seed in 0..4 {
+            let [kept, renewed, overlapping] = walk(shape, shape, seed, 1e-8, 1e-6);
+            // A slow walk keeps its plan most of the time, and renews it at the jumps
+            // and whenever a vertex comes near a plane.
+            assert!(
+                kept > renewed,
+                "{name} {seed}: kept {kept}, renewed {renewed}"
+            );
+            assert!(renewed >= 5, "{name} {seed}: renewed {renewed}");
+            assert!(
+                overlapping > 100,
+                "{name} {seed}: overlapping {overlapping}"
+            );
+            // A fast one renews it often; the answers stay the same.
+            walk(shape, shape, seed, 1e-5, 1e-3);
+        }
+    }
+    // Flush faces: cubes of equal orientation side by side, sliding along each other.
+    let mut cache = OverlapCache::default();
+    for k in 0..200 {
+        let pose = Isometry3::translation(0.0099, 1e-5 * k as Real, 2e-6 * k as Real);
+        let cached = overlap_cached(&cube, &cube, &pose, &mut cache);
+        assert_eq!(
+            bits(&cached),
+            bits(&overlap(&cube, &cube, &pose)),
+            "cube step {k}"
+        );
+        assert!(cached.is_some());
+    }
+}
