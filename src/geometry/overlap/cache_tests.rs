@@ -103,6 +103,17 @@ fn kept_plans_answer_bit_for_bit() {
             walk(shape, shape, seed, 1e-5, 1e-3);
         }
     }
+    // A plan is for its two shapes: the same slot and pose with other shapes renews it.
+    let pose = Isometry3::from_parts(
+        Translation3::new(0.0085, 0.0, 0.0),
+        UnitQuaternion::from_scaled_axis(Vector3::new(0.3, -0.7, 1.1)),
+    );
+    let mut cache = OverlapCache::default();
+    for (a, b) in [(&dodecahedron, &dodecahedron), (&cube, &dodecahedron)] {
+        let cached = overlap_cached(a, b, &pose, &mut cache);
+        assert_eq!(bits(&cached), bits(&overlap(a, b, &pose)));
+        assert!(cached.is_some());
+    }
     // Flush faces: cubes of equal orientation side by side, sliding along each other.
     let mut cache = OverlapCache::default();
     for k in 0..200 {

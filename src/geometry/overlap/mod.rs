@@ -182,6 +182,9 @@ pub fn overlap_with(
 /// and plans of more faces than fit, are not kept.
 #[derive(Clone, Debug)]
 pub struct OverlapCache {
+    /// The two shapes the plan is for (addresses): a pair whose particles were
+    /// replaced under the same list slot never uses another pair's plan.
+    shapes: (usize, usize),
     rotation: Matrix3<Real>,
     translation: Vector3<Real>,
     /// Negative: nothing kept.
@@ -199,6 +202,7 @@ const CACHED_FACES: usize = 12;
 impl Default for OverlapCache {
     fn default() -> Self {
         OverlapCache {
+            shapes: (0, 0),
             rotation: Matrix3::identity(),
             translation: Vector3::zeros(),
             margin: -1.0,
@@ -223,12 +227,13 @@ impl OverlapCache {
     /// beyond any margin.
     fn holds(
         &self,
+        shapes: (usize, usize),
         rotation: &Matrix3<Real>,
         translation: &Vector3<Real>,
         ra: Real,
         rb: Real,
     ) -> bool {
-        if self.margin <= 0.0 {
+        if self.margin <= 0.0 || shapes != self.shapes {
             return false;
         }
         let turn = (rotation - self.rotation).norm() * std::f64::consts::FRAC_1_SQRT_2;
@@ -240,6 +245,7 @@ impl OverlapCache {
     /// Keeps the plan in `s` for the pose (`rotation`, `translation`), if it fits.
     fn keep(
         &mut self,
+        shapes: (usize, usize),
         plan: &masked::FacePlan,
         rotation: Matrix3<Real>,
         translation: Vector3<Real>,
@@ -249,6 +255,7 @@ impl OverlapCache {
         if plan.faces.len() > CACHED_FACES {
             return;
         }
+        self.shapes = shapes;
         self.rotation = rotation;
         self.translation = translation;
         self.separated = plan.separated;
@@ -288,7 +295,8 @@ pub fn overlap_cached_with(
         return overlap_with(a, b, b_in_a, s);
     }
     let rotation = place_b(b, b_in_a, s);
-    if cache.holds(&rotation, &t, a.circumradius(), b.circumradius()) {
+    let shapes = (std::ptr::from_ref(a).addr(), std::ptr::from_ref(b).addr());
+    if cache.holds(shapes, &rotation, &t, a.circumradius(), b.circumradius()) {
         if cache.separated {
             return None;
         }
@@ -297,7 +305,7 @@ pub fn overlap_cached_with(
     }
     s.b_point_soa.fill(&s.b_points);
     masked::plan_masked(a, b, &t, s);
-    cache.keep(&s.plan, rotation, t, tolerance(a, b));
+    cache.keep(shapes, &s.plan, rotation, t, tolerance(a, b));
     overlap_by_plan(a, b, &t, s)
 }
 
