@@ -64,6 +64,7 @@ pub(super) fn plan_masked(
     t: &Vector3<Real>,
     s: &mut OverlapScratch,
 ) {
+    s.b_point_soa.fill(&s.b_points);
     // Most shapes have at most 64 vertices: their sets take half the operations.
     if a.vertices().len() <= 64 && b.vertices().len() <= 64 {
         plan_with_sets::<u64>(a, b, t, s)

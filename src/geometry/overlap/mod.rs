@@ -159,9 +159,10 @@ pub fn overlap_with(
     if t.norm() >= a.circumradius() + b.circumradius() {
         return None;
     }
-    place_b(b, b_in_a, s);
+    // A rotation matrix transforms points in half the work of a quaternion.
+    let rotation = b_in_a.rotation.to_rotation_matrix().into_inner();
+    place_b(b, &rotation, &t, s);
     if maskable(a) && maskable(b) {
-        s.b_point_soa.fill(&s.b_points);
         masked::plan_masked(a, b, &t, s);
         overlap_by_plan(a, b, &t, s)
     } else {
@@ -287,23 +288,25 @@ pub fn overlap_cached_with(
     cache: &mut OverlapCache,
     s: &mut OverlapScratch,
 ) -> Option<OverlapGeometry> {
+    if !(maskable(a) && maskable(b)) {
+        return overlap_with(a, b, b_in_a, s);
+    }
     let t = b_in_a.translation.vector;
     if t.norm() >= a.circumradius() + b.circumradius() {
         return None;
     }
-    if !(maskable(a) && maskable(b)) {
-        return overlap_with(a, b, b_in_a, s);
-    }
-    let rotation = place_b(b, b_in_a, s);
+    let rotation = b_in_a.rotation.to_rotation_matrix().into_inner();
     let shapes = (std::ptr::from_ref(a).addr(), std::ptr::from_ref(b).addr());
     if cache.holds(shapes, &rotation, &t, a.circumradius(), b.circumradius()) {
+        // A kept separation needs not even B's vertices.
         if cache.separated {
             return None;
         }
+        place_b(b, &rotation, &t, s);
         let (of_a, len) = (cache.of_a as usize, cache.len as usize);
         return masked::overlap_planned(a, b, &t, &cache.faces[..of_a], &cache.faces[of_a..len], s);
     }
-    s.b_point_soa.fill(&s.b_points);
+    place_b(b, &rotation, &t, s);
     masked::plan_masked(a, b, &t, s);
     cache.keep(shapes, &s.plan, rotation, t, tolerance(a, b));
     overlap_by_plan(a, b, &t, s)
@@ -331,12 +334,9 @@ fn maskable(p: &ConvexPolyhedron) -> bool {
     p.face_count() <= MASK_MAX_FACES && p.vertices().len() <= MASK_MAX_VERTICES
 }
 
-/// Puts B's vertices and planes into A's frame in `s` (and clears the piece
-/// vertices); returns B's rotation in A as a matrix.
-fn place_b(b: &ConvexPolyhedron, b_in_a: &Pose, s: &mut OverlapScratch) -> Matrix3<Real> {
-    let t = b_in_a.translation.vector;
-    // A rotation matrix transforms points in half the work of a quaternion.
-    let rot = b_in_a.rotation.to_rotation_matrix().into_inner();
+/// Puts B's vertices and planes into A's frame in `s` (B's rotation `rot` and
+/// centroid `t` in A), and clears the piece vertices.
+fn place_b(b: &ConvexPolyhedron, rot: &Matrix3<Real>, t: &Vector3<Real>, s: &mut OverlapScratch) {
     s.b_points.clear();
     s.b_points.extend(
         b.vertices()
@@ -348,11 +348,10 @@ fn place_b(b: &ConvexPolyhedron, b_in_a: &Pose, s: &mut OverlapScratch) -> Matri
         let normal = rot * p.normal;
         Plane {
             normal,
-            offset: p.offset + normal.dot(&t),
+            offset: p.offset + normal.dot(t),
         }
     }));
     s.points.clear();
-    rot
 }
 
 /// Coplanarity tolerance on plane distances.
