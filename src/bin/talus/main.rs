@@ -110,6 +110,10 @@ enum Command {
         /// Timed steps per run.
         #[arg(long, default_value_t = 200)]
         steps: usize,
+        /// Instead of measuring, pour the settled bed of scene (a) and write its
+        /// poses to this file (about an hour on two cores).
+        #[arg(long, value_name = "FILE")]
+        prepare_bed: Option<PathBuf>,
     },
     /// Check a particle mesh (STL or OBJ) and print its mass properties.
     Inspect {
@@ -168,7 +172,11 @@ fn main() -> Result<()> {
             fmi,
             library,
         } => fmu::fmu(&scene, &output, fmi, library),
-        Command::Bench { scale, steps } => bench::bench(bench::BenchOptions { scale, steps }),
+        Command::Bench {
+            prepare_bed: Some(out),
+            ..
+        } => bench::prepare_bed(&out),
+        Command::Bench { scale, steps, .. } => bench::bench(bench::BenchOptions { scale, steps }),
         Command::Inspect { mesh, hull, scale } => {
             let spec = ShapeSpec::Mesh {
                 file: mesh.clone(),
