@@ -105,3 +105,46 @@ fn bad_pair_file_names_file_and_field() {
         "{err}"
     );
 }
+
+#[test]
+fn bench_runs_on_part_of_the_shipped_settled_bed() {
+    // The shipped bed: 10 000 dodecahedra (circumradius 5 mm, inradius 3.97 mm) whose
+    // centroids lie in the 0.3155 m box at least an inradius from its walls, and on
+    // the floor: a bed about 65 mm deep with a rough top (a few pellets up to 91 mm),
+    // not the lattice it was poured from (centroids up to 120 mm).
+    let text = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("benches/data/settled_dodecahedra.csv"),
+    )
+    .expect("shipped bed");
+    let rows: Vec<Vec<f64>> = text
+        .lines()
+        .filter(|l| !l.starts_with('#'))
+        .skip(1)
+        .map(|l| l.split(',').map(|v| v.parse().expect("number")).collect())
+        .collect();
+    assert_eq!(rows.len(), 10_000);
+    let inradius = 0.005 * 0.7947;
+    for r in &rows {
+        for (k, x) in r[..3].iter().enumerate() {
+            let high = if k == 2 { 0.2 } else { 0.3155 };
+            assert!(*x > inradius * 0.99 && *x < high - inradius * 0.99, "{r:?}");
+        }
+    }
+    let top = rows.iter().map(|r| r[2]).fold(0.0, f64::max);
+    assert!(top < 0.1, "bed top at {top} m");
+
+    // Its lowest 500 particles, measured for a few steps: every row of scene (a)
+    // names them, with contacts among them and with the floor.
+    let (ok, out, err) = talus(&["bench", "--scale", "0.05", "--steps", "3"]);
+    assert!(ok, "{err}");
+    let rows: Vec<&str> = out.lines().filter(|l| l.starts_with("(a)")).collect();
+    assert_eq!(rows.len(), 2, "{out}");
+    for row in rows {
+        let fields: Vec<&str> = row.split_whitespace().collect();
+        let n = fields.len();
+        assert_eq!(fields[n - 7], "500", "{row}");
+        let contacts: f64 = fields[n - 5].parse().unwrap();
+        assert!(contacts > 500.0, "{row}");
+    }
+}
