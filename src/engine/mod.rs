@@ -9,6 +9,7 @@
 //! pair order, so results do not depend on the number of threads.
 
 pub mod broad_phase;
+mod fast_hash;
 pub mod integrate;
 mod laws;
 pub mod neighbours;

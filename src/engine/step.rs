@@ -2,7 +2,7 @@
 //! forces (in parallel over pairs and over particles), accumulation in a fixed order,
 //! and the closing kick.
 
-use std::collections::HashMap;
+use super::fast_hash::FastMap;
 
 use nalgebra::{Point3, Vector3};
 use rayon::prelude::*;
@@ -87,14 +87,14 @@ pub struct Engine {
     /// it is neither saved nor carried over a list build.
     overlap_plans: Vec<OverlapCache>,
     /// History set from outside, to be matched to the pairs at the next list build.
-    pending_history: Option<HashMap<(u64, u64), TangentialHistory>>,
+    pending_history: Option<FastMap<(u64, u64), TangentialHistory>>,
     /// Bounding radius of every particle, and the pair results of the last step
     /// (buffers kept between steps).
     radii: Vec<Real>,
     results: Vec<Option<ContactForce>>,
     /// Whether each particle touched another or a wall at the last force evaluation.
     touching: Vec<bool>,
-    wall_history: HashMap<WallKey, TangentialHistory>,
+    wall_history: FastMap<WallKey, TangentialHistory>,
     laws: ContactLaws,
     /// Number of particle–particle and particle–wall contacts in the last step.
     pub contacts: usize,
@@ -116,7 +116,7 @@ impl Engine {
             radii: Vec::new(),
             results: Vec::new(),
             touching: Vec::new(),
-            wall_history: HashMap::new(),
+            wall_history: FastMap::default(),
             laws: ContactLaws::default(),
             contacts: 0,
             elastic_energy: 0.0,
@@ -136,7 +136,7 @@ impl Engine {
     }
 
     /// The tangential history of the particle pairs, keyed by the two ids.
-    fn pair_history(&self) -> HashMap<(u64, u64), TangentialHistory> {
+    fn pair_history(&self) -> FastMap<(u64, u64), TangentialHistory> {
         if let Some(pending) = &self.pending_history {
             return pending.clone();
         }
@@ -353,7 +353,8 @@ impl Engine {
                 }
             })
             .collect();
-        let mut next_wall_history = HashMap::new();
+        let mut next_wall_history =
+            FastMap::with_capacity_and_hasher(self.wall_history.len(), Default::default());
         for (i, list) in wall_results.into_iter().enumerate() {
             for WallContact {
                 wall,
@@ -643,7 +644,7 @@ fn wall_contacts(
     world: &World,
     i: usize,
     list: &NeighbourList,
-    history: &HashMap<WallKey, TangentialHistory>,
+    history: &FastMap<WallKey, TangentialHistory>,
     laws: &ContactLaws,
     law: &LawParams,
 ) -> Vec<WallContact> {

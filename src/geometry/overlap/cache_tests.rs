@@ -6,7 +6,10 @@ use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 
-use super::{OverlapCache, OverlapGeometry, overlap, overlap_cached};
+use super::{
+    OverlapCache, OverlapGeometry, OverlapScratch, overlap, overlap_cached, overlap_cached_with,
+    overlap_with,
+};
 use crate::Real;
 use crate::geometry::{ConvexPolyhedron, generators};
 
@@ -59,6 +62,13 @@ fn walk(
     let mut translation = direction * 0.8 * reach;
     let mut cache = OverlapCache::default();
     let mut counts = [0; 3];
+    // The kept path places only the parts of B its plan reads: its scratch is filled
+    // with another pose's B before each step, so that a part it fails to place shows.
+    let mut scratch = OverlapScratch::default();
+    let elsewhere = Isometry3::from_parts(
+        Translation3::from(-direction * 0.7 * reach),
+        UnitQuaternion::from_scaled_axis(Vector3::new(1.0, 2.0, -0.5)),
+    );
     for k in 0..3000 {
         if k % 500 == 499 {
             // A jump: the plan must be renewed, not trusted.
@@ -70,7 +80,8 @@ fn walk(
         rotation = UnitQuaternion::from_scaled_axis(small_vector(&mut rng, turn)) * rotation;
         let pose = Isometry3::from_parts(Translation3::from(translation), rotation);
         let kept_before = (cache.translation, cache.margin);
-        let cached = overlap_cached(a, b, &pose, &mut cache);
+        overlap_with(a, b, &elsewhere, &mut scratch);
+        let cached = overlap_cached_with(a, b, &pose, &mut cache, &mut scratch);
         let fresh = overlap(a, b, &pose);
         assert_eq!(bits(&cached), bits(&fresh), "step {k}");
         let kept = kept_before == (cache.translation, cache.margin) && cache.margin > 0.0;

@@ -30,6 +30,20 @@ use crate::geometry::plane::PointSoa;
 use crate::geometry::polygon::FixedPolygon;
 use crate::geometry::{ConvexPolyhedron, Plane};
 
+/// What of B, placed in A's frame, the clipping of `faces_a` (the first `of_a`
+/// faces) and `faces_b` (the rest) reads: B's vertices (bits) and B's planes (bits).
+pub(super) fn b_parts_used(
+    b: &ConvexPolyhedron,
+    faces: &[PlannedFace],
+    of_a: usize,
+) -> (u128, u64) {
+    let (faces_a, faces_b) = faces.split_at(of_a);
+    let planes = faces_a.iter().fold(0, |m, f| m | f.planes);
+    faces_b.iter().fold((0, planes), |(v, p), f| {
+        (v | b.face_vertex_masks()[f.face as usize], p | 1 << f.face)
+    })
+}
+
 /// A face of one shape that bounds the intersection, with the planes of the other
 /// shape to clip it by.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]

@@ -194,6 +194,10 @@ pub struct OverlapCache {
     faces: [masked::PlannedFace; CACHED_FACES],
     of_a: u8,
     len: u8,
+    /// B's vertices and planes (bits) that clipping by the plan reads: only these are
+    /// placed in A's frame while the plan holds.
+    b_vertices: u128,
+    b_planes: u64,
 }
 
 /// Most planned faces (of both shapes together) an [`OverlapCache`] keeps: a shallow
@@ -211,6 +215,8 @@ impl Default for OverlapCache {
             faces: [masked::PlannedFace::default(); CACHED_FACES],
             of_a: 0,
             len: 0,
+            b_vertices: 0,
+            b_planes: 0,
         }
     }
 }
@@ -246,6 +252,7 @@ impl OverlapCache {
     /// Keeps the plan in `s` for the pose (`rotation`, `translation`), if it fits.
     fn keep(
         &mut self,
+        b: &ConvexPolyhedron,
         shapes: (usize, usize),
         plan: &masked::FacePlan,
         rotation: Matrix3<Real>,
@@ -263,6 +270,7 @@ impl OverlapCache {
         self.faces[..plan.faces.len()].copy_from_slice(&plan.faces);
         self.of_a = plan.of_a as u8;
         self.len = plan.faces.len() as u8;
+        (self.b_vertices, self.b_planes) = masked::b_parts_used(b, &plan.faces, plan.of_a);
         // A distance at the new pose carries round-off well below the tolerance.
         self.margin = plan.margin - tol;
     }
@@ -302,13 +310,13 @@ pub fn overlap_cached_with(
         if cache.separated {
             return None;
         }
-        place_b(b, &rotation, &t, s);
+        place_b_parts(b, &rotation, &t, cache.b_vertices, cache.b_planes, s);
         let (of_a, len) = (cache.of_a as usize, cache.len as usize);
         return masked::overlap_planned(a, b, &t, &cache.faces[..of_a], &cache.faces[of_a..len], s);
     }
     place_b(b, &rotation, &t, s);
     masked::plan_masked(a, b, &t, s);
-    cache.keep(shapes, &s.plan, rotation, t, tolerance(a, b));
+    cache.keep(b, shapes, &s.plan, rotation, t, tolerance(a, b));
     overlap_by_plan(a, b, &t, s)
 }
 
@@ -351,6 +359,42 @@ fn place_b(b: &ConvexPolyhedron, rot: &Matrix3<Real>, t: &Vector3<Real>, s: &mut
             offset: p.offset + normal.dot(t),
         }
     }));
+    s.points.clear();
+}
+
+/// [`place_b`] for the vertices (bits) `vertices` and the planes (bits) `planes` of
+/// B only; the others keep whatever they held.
+fn place_b_parts(
+    b: &ConvexPolyhedron,
+    rot: &Matrix3<Real>,
+    t: &Vector3<Real>,
+    mut vertices: u128,
+    mut planes: u64,
+    s: &mut OverlapScratch,
+) {
+    s.b_points.resize(b.vertices().len(), Point3::origin());
+    while vertices != 0 {
+        let v = vertices.trailing_zeros() as usize;
+        vertices &= vertices - 1;
+        s.b_points[v] = Point3::from(rot * b.vertices()[v].coords + t);
+    }
+    s.b_planes.resize(
+        b.face_count(),
+        Plane {
+            normal: Vector3::zeros(),
+            offset: 0.0,
+        },
+    );
+    while planes != 0 {
+        let k = planes.trailing_zeros() as usize;
+        planes &= planes - 1;
+        let p = &b.planes()[k];
+        let normal = rot * p.normal;
+        s.b_planes[k] = Plane {
+            normal,
+            offset: p.offset + normal.dot(t),
+        };
+    }
     s.points.clear();
 }
 
