@@ -1,9 +1,9 @@
-//! `talus bench`: whole-step throughput on two standard scenes, on 1 and 2 threads,
+//! `talus bench`: whole-step throughput on three standard scenes, on 1 and 2 threads,
 //! with the accuracy the step was run at.
 //!
 //! (a) A dense settled bed of dodecahedra: 10 000 regular dodecahedra (circumradius
-//!     5 mm) poured into a box under gravity and come to rest. Pouring takes about an
-//!     hour on two cores, so the bed's poses ship with talus
+//!     5 mm) poured into a box under gravity, come to rest. Pouring takes about 20
+//!     minutes on two cores even quenched, so the bed's poses ship with talus
 //!     (`benches/data/settled_dodecahedra.csv`); `talus bench --prepare-bed FILE`
 //!     makes them again (see [`prepare_bed`]). A smaller `--scale` keeps the lowest
 //!     particles, a shallower settled bed in the same box.
@@ -45,8 +45,9 @@ restitution = 0.5
 friction = 0.5
 "#;
 
-/// The settled bed of scene (a): `x,y,z,qw,qx,qy,qz` of 10 000 dodecahedra at rest
-/// in [`BED_BOX`], written by [`prepare_bed`].
+/// The settled bed of scene (a): `x,y,z,qw,qx,qy,qz` of 10 000 dodecahedra resting
+/// in [`BED_BOX`] (a few pellets along the walls still slide), written by
+/// [`prepare_bed`].
 const SETTLED_BED: &str = include_str!("../../../benches/data/settled_dodecahedra.csv");
 
 /// The box of the settled bed: 0.3155 m square (30 lattice columns at 2.1
