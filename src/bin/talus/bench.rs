@@ -145,8 +145,8 @@ fn run_stage(text: &str, dir: &Path, stage: &Stage) -> Result<(String, Real)> {
             p.velocity.iter_mut().for_each(|v| *v *= keep);
             p.angular_momentum.iter_mut().for_each(|l| *l *= keep);
         }
-        let report = sim.report();
         if sim.steps % 2000 == 0 {
+            let report = sim.report();
             eprintln!(
                 "{}: t = {:.4} s (dt {:.2e}), {} contacts, largest speed {:.2e} m/s, {:.0} s",
                 stage.name,

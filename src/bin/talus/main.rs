@@ -111,7 +111,7 @@ enum Command {
         #[arg(long, default_value_t = 200)]
         steps: usize,
         /// Instead of measuring, pour the settled bed of scene (a) and write its
-        /// poses to this file (about an hour on two cores).
+        /// poses to this file (about 20 minutes on two cores).
         #[arg(long, value_name = "FILE")]
         prepare_bed: Option<PathBuf>,
     },

@@ -350,7 +350,7 @@ fn planes_reached(planes: &[Plane], centre: &Point3<Real>, radius: Real, tol: Re
 
 /// Indices of the set bits of `mask`, lowest first.
 #[inline]
-fn bits(mut mask: u64) -> impl Iterator<Item = usize> {
+pub(super) fn bits(mut mask: u64) -> impl Iterator<Item = usize> {
     std::iter::from_fn(move || {
         (mask != 0).then(|| {
             let k = mask.trailing_zeros() as usize;

@@ -352,14 +352,19 @@ fn place_b(b: &ConvexPolyhedron, rot: &Matrix3<Real>, t: &Vector3<Real>, s: &mut
             .map(|p| Point3::from(rot * p.coords + t)),
     );
     s.b_planes.clear();
-    s.b_planes.extend(b.planes().iter().map(|p| {
-        let normal = rot * p.normal;
-        Plane {
-            normal,
-            offset: p.offset + normal.dot(t),
-        }
-    }));
+    s.b_planes
+        .extend(b.planes().iter().map(|p| plane_in_a(p, rot, t)));
     s.points.clear();
+}
+
+/// A plane of B in A's frame (B's rotation `rot` and centroid `t` in A).
+#[inline]
+fn plane_in_a(p: &Plane, rot: &Matrix3<Real>, t: &Vector3<Real>) -> Plane {
+    let normal = rot * p.normal;
+    Plane {
+        normal,
+        offset: p.offset + normal.dot(t),
+    }
 }
 
 /// [`place_b`] for the vertices (bits) `vertices` and the planes (bits) `planes` of
@@ -369,7 +374,7 @@ fn place_b_parts(
     rot: &Matrix3<Real>,
     t: &Vector3<Real>,
     mut vertices: u128,
-    mut planes: u64,
+    planes: u64,
     s: &mut OverlapScratch,
 ) {
     s.b_points.resize(b.vertices().len(), Point3::origin());
@@ -385,15 +390,8 @@ fn place_b_parts(
             offset: 0.0,
         },
     );
-    while planes != 0 {
-        let k = planes.trailing_zeros() as usize;
-        planes &= planes - 1;
-        let p = &b.planes()[k];
-        let normal = rot * p.normal;
-        s.b_planes[k] = Plane {
-            normal,
-            offset: p.offset + normal.dot(t),
-        };
+    for k in masked::bits(planes) {
+        s.b_planes[k] = plane_in_a(&b.planes()[k], rot, t);
     }
     s.points.clear();
 }
