@@ -38,7 +38,12 @@ pub(crate) fn clip_with_distances(
 /// The point where the segment from `inside` (distance `di <= 0`) to `outside`
 /// (distance `do_ > 0`) meets the plane.
 #[inline]
-fn cut(inside: &Point3<Real>, di: Real, outside: &Point3<Real>, do_: Real) -> Point3<Real> {
+pub(crate) fn cut(
+    inside: &Point3<Real>,
+    di: Real,
+    outside: &Point3<Real>,
+    do_: Real,
+) -> Point3<Real> {
     let t = di / (di - do_);
     inside + (outside - inside) * t
 }
@@ -165,14 +170,28 @@ impl SurfaceSums {
         poly: &[Point3<Real>],
         normal: &Vector3<Real>,
     ) -> (Vector3<Real>, Vector3<Real>) {
-        let p0 = poly[0];
+        self.add_piece_by(poly.len(), |k| poly[k], normal)
+    }
+
+    /// [`SurfaceSums::add_piece`] for the piece of `len` vertices whose `k`-th is
+    /// `vertex(k)`.
+    #[inline]
+    pub(crate) fn add_piece_by(
+        &mut self,
+        len: usize,
+        vertex: impl Fn(usize) -> Point3<Real>,
+        normal: &Vector3<Real>,
+    ) -> (Vector3<Real>, Vector3<Real>) {
+        let p0 = vertex(0);
         let apex = *self.apex.get_or_insert(p0);
         let (mut twice_area, mut spread) = (0.0, Vector3::zeros());
-        for k in 1..poly.len() - 1 {
-            let (u, v) = (poly[k] - p0, poly[k + 1] - p0);
+        let mut u = vertex(1) - p0;
+        for k in 2..len {
+            let v = vertex(k) - p0;
             let w = normal.dot(&u.cross(&v));
             twice_area += w;
             spread += w * (u + v);
+            u = v;
         }
         // Σ w_k (p_0 + p_k + p_{k+1}) = spread + 3 p_0 Σ w_k.
         let offset = p0 - apex;

@@ -405,10 +405,20 @@ pub struct BenchOptions {
     pub scale: f64,
     /// Timed steps per run.
     pub steps: usize,
+    /// The scenes to measure, by letter (all when empty).
+    pub scenes: Vec<char>,
+    /// The thread counts to measure on.
+    pub threads: Vec<usize>,
 }
 
 /// `talus bench`.
 pub fn bench(options: BenchOptions) -> Result<()> {
+    if let Some(bad) = options.scenes.iter().find(|c| !"abc".contains(**c)) {
+        bail!("--scene {bad}: the scenes are a, b and c");
+    }
+    if options.threads.contains(&0) {
+        bail!("--threads: a thread count is at least 1");
+    }
     let dir = std::env::temp_dir().join(format!("talus-bench-{}", std::process::id()));
     std::fs::create_dir_all(&dir)?;
     let bed_count = (10_000.0 * options.scale).round() as usize;
@@ -427,20 +437,24 @@ pub fn bench(options: BenchOptions) -> Result<()> {
         .collect();
     talus::geometry::mesh_io::write_stl(&dir.join("box.stl"), &walls.vertices, &tris)?;
     let sphere = "kind = \"sphere\"\nradius = 0.005";
+    let wanted = |letter: char| options.scenes.is_empty() || options.scenes.contains(&letter);
     let cases = [
         (
+            'a',
             "(a) settled bed of dodecahedra",
             settled_bed(&dir, bed_count)?,
             DODECAHEDRON,
             0.2,
         ),
         (
+            'b',
             "(b) spheres falling into an STL box",
             spheres(sphere_side, 20),
             sphere,
             0.01,
         ),
         (
+            'c',
             "(c) dense bed of spheres",
             dense_lattice(sphere_bed_side, sphere, 1.98),
             sphere,
@@ -460,12 +474,12 @@ pub fn bench(options: BenchOptions) -> Result<()> {
         "contacts/s",
         "e error"
     );
-    for (name, text, shape, reg) in cases {
+    for (_, name, text, shape, reg) in cases.into_iter().filter(|c| wanted(c.0)) {
         let path = dir.join("scene.toml");
         std::fs::write(&path, &text)?;
         let scene = Scene::load(&path)?;
         let error = restitution_error(shape, scene.dt, reg);
-        for threads in [1, 2] {
+        for &threads in &options.threads {
             let m = measure(&scene, threads, 200, options.steps)?;
             println!(
                 "{:<38} {:>7} {:>9} {:>10} {:>9.0} {:>8.1e} {:>16.3e} {:>14.3e} {:>9.2}%",

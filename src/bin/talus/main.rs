@@ -110,6 +110,12 @@ enum Command {
         /// Timed steps per run.
         #[arg(long, default_value_t = 200)]
         steps: usize,
+        /// Measure only these scenes (a, b, c; all by default).
+        #[arg(long, value_delimiter = ',')]
+        scene: Vec<char>,
+        /// Measure on these thread counts.
+        #[arg(long, value_delimiter = ',', default_values_t = [1, 2])]
+        threads: Vec<usize>,
         /// Instead of measuring, pour the settled bed of scene (a) and write its
         /// poses to this file (about 20 minutes on two cores).
         #[arg(long, value_name = "FILE")]
@@ -176,7 +182,18 @@ fn main() -> Result<()> {
             prepare_bed: Some(out),
             ..
         } => bench::prepare_bed(&out),
-        Command::Bench { scale, steps, .. } => bench::bench(bench::BenchOptions { scale, steps }),
+        Command::Bench {
+            scale,
+            steps,
+            scene,
+            threads,
+            ..
+        } => bench::bench(bench::BenchOptions {
+            scale,
+            steps,
+            scenes: scene,
+            threads,
+        }),
         Command::Inspect { mesh, hull, scale } => {
             let spec = ShapeSpec::Mesh {
                 file: mesh.clone(),

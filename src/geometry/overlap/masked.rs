@@ -55,6 +55,18 @@ pub(super) struct PlannedFace {
     flush: bool,
 }
 
+impl PlannedFace {
+    /// The face's index in its shape.
+    pub(super) fn face(&self) -> usize {
+        self.face as usize
+    }
+
+    /// The other shape's planes (bits) that cut it.
+    pub(super) fn planes(&self) -> u64 {
+        self.planes
+    }
+}
+
 /// Every discrete decision of the masked path at one relative pose: whether a plane
 /// separates the shapes, and which faces of A, then of B, bound the intersection,
 /// each with the planes that cut it.

@@ -50,6 +50,7 @@
 
 mod culled;
 mod masked;
+mod topology;
 
 use std::cell::RefCell;
 
@@ -59,6 +60,7 @@ use super::plane::{PlaneSoa, PointSoa};
 use super::polygon::{FixedPolygon, SurfaceSums};
 use super::{ConvexPolyhedron, Plane, Pose};
 use crate::Real;
+use topology::Topology;
 
 /// Shapes with at most this many faces (cut-plane sets are `u64` masks) and vertices
 /// (vertex sets are `u128` masks) each take the bit-mask path. A convex polyhedron of
@@ -132,6 +134,9 @@ pub struct OverlapScratch {
     poly_tmp: Vec<Point3<Real>>,
     dist: Vec<Real>,
     points: Vec<Point3<Real>>,
+    /// The labelled clipping's double buffer, and edges of B near A (topology).
+    labelled: [Vec<topology::LabelledVertex>; 2],
+    near_edges: Vec<[u32; 2]>,
 }
 
 thread_local! {
@@ -164,7 +169,8 @@ pub fn overlap_with(
     place_b(b, &rotation, &t, s);
     if maskable(a) && maskable(b) {
         masked::plan_masked(a, b, &t, s);
-        overlap_by_plan(a, b, &t, s)
+        let topology = topology_of_plan(a, b, s);
+        overlap_by_plan(a, b, &t, topology.as_ref(), s)
     } else {
         culled::overlap_culled(a, b, b_in_a, s)
     }
@@ -194,8 +200,11 @@ pub struct OverlapCache {
     faces: [masked::PlannedFace; CACHED_FACES],
     of_a: u8,
     len: u8,
-    /// B's vertices and planes (bits) that clipping by the plan reads: only these are
-    /// placed in A's frame while the plan holds.
+    /// The intersection's topology where it has one: while it holds (the margin then
+    /// also covers edge–edge crossings) it is evaluated instead of clipping the plan.
+    topology: Option<Topology>,
+    /// B's vertices and planes (bits) that clipping by the plan, or evaluating the
+    /// topology, reads: only these are placed in A's frame while the plan holds.
     b_vertices: u128,
     b_planes: u64,
 }
@@ -215,6 +224,7 @@ impl Default for OverlapCache {
             faces: [masked::PlannedFace::default(); CACHED_FACES],
             of_a: 0,
             len: 0,
+            topology: None,
             b_vertices: 0,
             b_planes: 0,
         }
@@ -249,30 +259,45 @@ impl OverlapCache {
         drift < self.margin
     }
 
-    /// Keeps the plan in `s` for the pose (`rotation`, `translation`), if it fits.
+    /// Keeps the plan in `s`, and the topology `topology` read off it, for the pose
+    /// (`rotation`, `translation`), if it fits.
+    #[allow(clippy::too_many_arguments)]
     fn keep(
         &mut self,
+        a: &ConvexPolyhedron,
         b: &ConvexPolyhedron,
         shapes: (usize, usize),
-        plan: &masked::FacePlan,
+        topology: Option<&Topology>,
         rotation: Matrix3<Real>,
         translation: Vector3<Real>,
-        tol: Real,
+        s: &mut OverlapScratch,
     ) {
         self.margin = -1.0;
-        if plan.faces.len() > CACHED_FACES {
+        let plan = &s.plan;
+        if plan.faces.len() > CACHED_FACES && topology.is_none() {
             return;
         }
         self.shapes = shapes;
         self.rotation = rotation;
         self.translation = translation;
         self.separated = plan.separated;
-        self.faces[..plan.faces.len()].copy_from_slice(&plan.faces);
-        self.of_a = plan.of_a as u8;
-        self.len = plan.faces.len() as u8;
-        (self.b_vertices, self.b_planes) = masked::b_parts_used(b, &plan.faces, plan.of_a);
+        let mut margin = plan.margin;
+        match topology {
+            Some(topology) => {
+                self.topology = Some(topology.clone());
+                (self.b_vertices, self.b_planes) = topology.b_parts_used();
+                margin = margin.min(topology::edge_margin(a, b, s));
+            }
+            None => {
+                self.topology = None;
+                self.faces[..plan.faces.len()].copy_from_slice(&plan.faces);
+                self.of_a = plan.of_a as u8;
+                self.len = plan.faces.len() as u8;
+                (self.b_vertices, self.b_planes) = masked::b_parts_used(b, &plan.faces, plan.of_a);
+            }
+        }
         // A distance at the new pose carries round-off well below the tolerance.
-        self.margin = plan.margin - tol;
+        self.margin = margin - tolerance(a, b);
     }
 }
 
@@ -311,24 +336,48 @@ pub fn overlap_cached_with(
             return None;
         }
         place_b_parts(b, &rotation, &t, cache.b_vertices, cache.b_planes, s);
+        if let Some(topology) = &cache.topology {
+            return topology.evaluate(a, &t, s);
+        }
         let (of_a, len) = (cache.of_a as usize, cache.len as usize);
         return masked::overlap_planned(a, b, &t, &cache.faces[..of_a], &cache.faces[of_a..len], s);
     }
     place_b(b, &rotation, &t, s);
     masked::plan_masked(a, b, &t, s);
-    cache.keep(b, shapes, &s.plan, rotation, t, tolerance(a, b));
-    overlap_by_plan(a, b, &t, s)
+    let topology = topology_of_plan(a, b, s);
+    cache.keep(a, b, shapes, topology.as_ref(), rotation, t, s);
+    overlap_by_plan(a, b, &t, topology.as_ref(), s)
 }
 
-/// The overlap by the plan in `s`.
+/// The topology of the intersection by the plan in `s`, where it has one.
+fn topology_of_plan(
+    a: &ConvexPolyhedron,
+    b: &ConvexPolyhedron,
+    s: &mut OverlapScratch,
+) -> Option<Topology> {
+    if s.plan.separated {
+        return None;
+    }
+    let plan = std::mem::take(&mut s.plan);
+    let topology = Topology::read(a, b, &plan, s);
+    s.plan = plan;
+    topology
+}
+
+/// The overlap by the plan in `s`: by its topology where it has one (all of B in A's
+/// frame in `s`).
 fn overlap_by_plan(
     a: &ConvexPolyhedron,
     b: &ConvexPolyhedron,
     t: &Vector3<Real>,
+    topology: Option<&Topology>,
     s: &mut OverlapScratch,
 ) -> Option<OverlapGeometry> {
     if s.plan.separated {
         return None;
+    }
+    if let Some(topology) = topology {
+        return topology.evaluate(a, t, s);
     }
     let plan = std::mem::take(&mut s.plan);
     let (faces_a, faces_b) = plan.faces.split_at(plan.of_a);
@@ -432,7 +481,40 @@ impl Pieces {
         flush: bool,
         points: &mut Vec<Point3<Real>>,
     ) {
-        let (area, moment) = self.surface.add_piece(poly, normal);
+        self.add_sums(poly, normal, of_b, flush);
+        points.extend_from_slice(poly);
+    }
+
+    /// [`Pieces::add`] without keeping the vertices.
+    #[inline]
+    fn add_sums(&mut self, poly: &[Point3<Real>], normal: &Vector3<Real>, of_b: bool, flush: bool) {
+        let sums = self.surface.add_piece(poly, normal);
+        self.add_to_side(sums, of_b, flush);
+    }
+
+    /// Adds a piece whose vertices are `points[loop_[k]]`, of a face of A or, with
+    /// `of_b`, of B.
+    #[inline]
+    fn add_loop(
+        &mut self,
+        points: &[Point3<Real>],
+        loop_: &[u8],
+        normal: &Vector3<Real>,
+        of_b: bool,
+    ) {
+        let sums = self
+            .surface
+            .add_piece_by(loop_.len(), |k| points[loop_[k] as usize], normal);
+        self.add_to_side(sums, of_b, false);
+    }
+
+    #[inline]
+    fn add_to_side(
+        &mut self,
+        (area, moment): (Vector3<Real>, Vector3<Real>),
+        of_b: bool,
+        flush: bool,
+    ) {
         let side = if of_b { &mut self.b } else { &mut self.a };
         if flush {
             side.flush_area += area;
@@ -441,7 +523,6 @@ impl Pieces {
             side.area += area;
             side.moment += moment;
         }
-        points.extend_from_slice(poly);
     }
 }
 
