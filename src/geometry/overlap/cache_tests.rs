@@ -79,12 +79,12 @@ fn walk(
         translation += small_vector(&mut rng, step) + direction * (breathe * 0.3 * step);
         rotation = UnitQuaternion::from_scaled_axis(small_vector(&mut rng, turn)) * rotation;
         let pose = Isometry3::from_parts(Translation3::from(translation), rotation);
-        let kept_before = (cache.translation, cache.margin);
+        let kept_before = (cache.translation, cache.slack);
         overlap_with(a, b, &elsewhere, &mut scratch);
         let cached = overlap_cached_with(a, b, &pose, &mut cache, &mut scratch);
         let fresh = overlap(a, b, &pose);
         assert_eq!(bits(&cached), bits(&fresh), "step {k}");
-        let kept = kept_before == (cache.translation, cache.margin) && cache.margin > 0.0;
+        let kept = kept_before == (cache.translation, cache.slack) && cache.slack.is_some();
         counts[if kept { 0 } else { 1 }] += 1;
         counts[2] += fresh.is_some() as usize;
     }

@@ -76,10 +76,65 @@ pub(super) struct FacePlan {
     /// Faces of A (the first `of_a`), then faces of B.
     pub(super) faces: Vec<PlannedFace>,
     pub(super) of_a: usize,
-    /// Smallest distance by which a vertex–plane or bounding-ball–plane test missed
-    /// its thresholds: while no vertex of either shape moves this far relative to the
-    /// other's planes, every decision comes out the same.
+    /// The slack of the decisions (see [`Slack`]): while no vertex of either shape
+    /// moves relative to the other's planes by as much as the test it enters missed
+    /// its threshold by, every decision comes out the same.
+    pub(super) slack: Slack,
+}
+
+/// How far the tests of a pose are from going the other way: the smallest miss
+/// `margin` (metres), and the smallest miss per unit lever `per_lever` (metres per
+/// radian), where a test's lever is the distance of its point from the pivot `c`.
+///
+/// If B moves relative to A so that its material point at `c` is displaced by `a`
+/// and its orientation turns by `θ` (spectral norm of the change of rotation), a
+/// point at lever `L` is displaced by at most `a + θ L`, and no test of miss `m ≥
+/// margin` with `m / L ≥ per_lever` can change while `a / margin + θ / per_lever < 1`.
+/// Tests near the contact have small misses but short levers, so this holds for far
+/// larger turns than one bound with the longest lever would.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct Slack {
     pub(super) margin: Real,
+    pub(super) per_lever: Real,
+}
+
+impl Default for Slack {
+    fn default() -> Self {
+        Slack::NONE
+    }
+}
+
+impl Slack {
+    /// No test yet: nothing limits the motion.
+    pub(super) const NONE: Slack = Slack {
+        margin: Real::INFINITY,
+        per_lever: Real::INFINITY,
+    };
+
+    /// The slack of both sets of tests.
+    pub(super) fn min(self, other: Slack) -> Slack {
+        Slack {
+            margin: self.margin.min(other.margin),
+            per_lever: self.per_lever.min(other.per_lever),
+        }
+    }
+
+    /// Whether a displacement `a` at the pivot and a turn `turn` leave every test
+    /// as it was.
+    pub(super) fn holds(&self, a: Real, turn: Real) -> bool {
+        self.margin > 0.0
+            && self.per_lever > 0.0
+            && a * self.per_lever + turn * self.margin < self.margin * self.per_lever
+    }
+}
+
+/// Per point of `points`, the inverse of its distance from `pivot` (into `inverse`).
+pub(super) fn inverse_levers(points: &PointSoa, pivot: &Point3<Real>, inverse: &mut Vec<Real>) {
+    inverse.clear();
+    inverse.extend((0..points.x.len()).map(|k| {
+        let d = Vector3::new(points.x[k], points.y[k], points.z[k]) - pivot.coords;
+        1.0 / d.norm().max(Real::MIN_POSITIVE)
+    }));
 }
 
 /// Plans the overlap of `a` and `b` into `s.plan` (B's vertices and planes already in
@@ -109,14 +164,24 @@ fn plan_with_sets<M: VertexSet>(
     let tol = tolerance(a, b);
     // Planes that hold the other shape's bounding sphere wholly inside can neither
     // cut nor separate; about half of each shape's planes face away from the other.
+    // The balls' centres, A's origin and `t`, both lie |t|/2 from the pivot t/2.
     let (reached_a, margin_a) =
         planes_reached(a.planes(), &Point3::from(*t), b.circumradius(), tol);
     let (reached_b, margin_b) =
         planes_reached(&s.b_planes, &Point3::origin(), a.circumradius(), tol);
+    let ball_margin = margin_a.min(margin_b);
+    let balls = Slack {
+        margin: ball_margin,
+        per_lever: ball_margin / (0.5 * t.norm()).max(Real::MIN_POSITIVE),
+    };
+    let pivot = Point3::from(0.5 * t);
+    inverse_levers(a.vertex_soa(), &pivot, &mut s.inverse_lever_a);
+    inverse_levers(&s.b_point_soa, &pivot, &mut s.inverse_lever_b);
     let (all_a, all_b) = (M::first(a.vertices().len()), M::first(b.vertices().len()));
     let (out_a, on_a) = (&mut s.out_a, &mut s.on_a);
     let masks_a = vertex_masks(
         a.vertex_soa(),
+        &s.inverse_lever_a,
         &s.b_planes,
         reached_b,
         tol,
@@ -127,6 +192,7 @@ fn plan_with_sets<M: VertexSet>(
     let (out_b, on_b) = (&mut s.out_b, &mut s.on_b);
     let masks_b = vertex_masks(
         &s.b_point_soa,
+        &s.inverse_lever_b,
         a.planes(),
         reached_a,
         tol,
@@ -135,7 +201,7 @@ fn plan_with_sets<M: VertexSet>(
         on_b,
     );
     let plan = &mut s.plan;
-    plan.margin = margin_a.min(margin_b).min(masks_a).min(masks_b);
+    plan.slack = balls.min(masks_a).min(masks_b);
     plan.faces.clear();
     plan.of_a = 0;
     let side_a = MaskedSide::<M>::new(a, a.planes(), reached_a, &s.out_a, &s.on_a);
@@ -386,49 +452,52 @@ fn clip_by_planes(poly: &mut FixedPolygon, cut: u64, planes: &[Plane]) {
 /// For each plane `k` in `active`, sets bit `v` of `out[k]` when point `v` lies more
 /// than `tol` outside the plane, and of `on[k]` when it lies within `tol` of it; bits
 /// outside `real` (the set of the real, unpadded points) are cleared, and so are the
-/// masks of the planes not in `active`. Returns the smallest `||d| − tol|` over the
-/// distances `d` tested (padding included): how far the closest call was from going
-/// the other way.
+/// masks of the planes not in `active`. Returns the slack of the tests: the smallest
+/// miss `||d| − tol|` over the distances `d` tested (padding included), and the
+/// smallest miss times the point's `inverse_lever`.
+#[allow(clippy::too_many_arguments)]
 fn vertex_masks<M: VertexSet>(
     points: &PointSoa,
+    inverse_lever: &[Real],
     planes: &[Plane],
     active: u64,
     tol: Real,
     real: M,
     out: &mut Vec<u128>,
     on: &mut Vec<u128>,
-) -> Real {
+) -> Slack {
     out.clear();
     on.clear();
     out.resize(planes.len(), 0);
     on.resize(planes.len(), 0);
     #[cfg(target_arch = "x86_64")]
-    let margin = if std::arch::is_x86_feature_detected!("avx2")
+    let slack = if std::arch::is_x86_feature_detected!("avx2")
         && std::arch::is_x86_feature_detected!("fma")
     {
         // SAFETY: the CPU supports the features the function is compiled for.
-        unsafe { vertex_masks_avx2::<M>(points, planes, active, tol, out, on) }
+        unsafe { vertex_masks_avx2::<M>(points, inverse_lever, planes, active, tol, out, on) }
     } else {
-        vertex_masks_scalar(points, planes, active, tol, out, on)
+        vertex_masks_scalar(points, inverse_lever, planes, active, tol, out, on)
     };
     #[cfg(not(target_arch = "x86_64"))]
-    let margin = vertex_masks_scalar(points, planes, active, tol, out, on);
+    let slack = vertex_masks_scalar(points, inverse_lever, planes, active, tol, out, on);
     let real = real.widen();
     for m in out.iter_mut().chain(on.iter_mut()) {
         *m &= real;
     }
-    margin
+    slack
 }
 
 fn vertex_masks_scalar(
     points: &PointSoa,
+    inverse_lever: &[Real],
     planes: &[Plane],
     active: u64,
     tol: Real,
     out: &mut [u128],
     on: &mut [u128],
-) -> Real {
-    let mut margin = Real::INFINITY;
+) -> Slack {
+    let mut slack = Slack::NONE;
     for k in bits(active) {
         let p = &planes[k];
         let (mut o, mut n) = (0u128, 0u128);
@@ -437,12 +506,16 @@ fn vertex_masks_scalar(
                 - p.offset;
             o |= ((d > tol) as u128) << v;
             n |= ((d <= tol && d >= -tol) as u128) << v;
-            margin = margin.min((d.abs() - tol).abs());
+            let miss = (d.abs() - tol).abs();
+            slack = slack.min(Slack {
+                margin: miss,
+                per_lever: miss * inverse_lever[v],
+            });
         }
         out[k] = o;
         on[k] = n;
     }
-    margin
+    slack
 }
 
 /// [`vertex_masks_scalar`] four points at a time, the masks read off the sign bits.
@@ -450,18 +523,20 @@ fn vertex_masks_scalar(
 #[target_feature(enable = "avx2,fma")]
 unsafe fn vertex_masks_avx2<M: VertexSet>(
     points: &PointSoa,
+    inverse_lever: &[Real],
     planes: &[Plane],
     active: u64,
     tol: Real,
     out: &mut [u128],
     on: &mut [u128],
-) -> Real {
+) -> Slack {
     use std::arch::x86_64::*;
     let chunks = points.x.len() / 4;
     let tol_v = _mm256_set1_pd(tol);
     let neg_tol_v = _mm256_set1_pd(-tol);
     let sign = _mm256_set1_pd(-0.0);
     let mut margin = _mm256_set1_pd(Real::INFINITY);
+    let mut per_lever = _mm256_set1_pd(Real::INFINITY);
     for k in bits(active) {
         let p = &planes[k];
         let (nx, ny, nz, off) = (
@@ -474,11 +549,12 @@ unsafe fn vertex_masks_avx2<M: VertexSet>(
         let (mut o, mut n) = (M::EMPTY, M::EMPTY);
         for c in (0..chunks).rev() {
             // SAFETY: each array holds 4 * chunks values.
-            let (x, y, z) = unsafe {
+            let (x, y, z, inverse) = unsafe {
                 (
                     _mm256_loadu_pd(points.x.as_ptr().add(4 * c)),
                     _mm256_loadu_pd(points.y.as_ptr().add(4 * c)),
                     _mm256_loadu_pd(points.z.as_ptr().add(4 * c)),
+                    _mm256_loadu_pd(inverse_lever.as_ptr().add(4 * c)),
                 )
             };
             let d = _mm256_fmadd_pd(nz, z, _mm256_fmadd_pd(ny, y, _mm256_fmsub_pd(nx, x, off)));
@@ -490,15 +566,23 @@ unsafe fn vertex_masks_avx2<M: VertexSet>(
             o = o.shifted_in(outside);
             n = n.shifted_in(on_plane);
             let miss = _mm256_sub_pd(_mm256_andnot_pd(sign, d), tol_v);
-            margin = _mm256_min_pd(margin, _mm256_andnot_pd(sign, miss));
+            let miss = _mm256_andnot_pd(sign, miss);
+            margin = _mm256_min_pd(margin, miss);
+            per_lever = _mm256_min_pd(per_lever, _mm256_mul_pd(miss, inverse));
         }
         out[k] = o.widen();
         on[k] = n.widen();
     }
-    let mut lanes = [0.0; 4];
-    // SAFETY: `lanes` holds four values.
-    unsafe { _mm256_storeu_pd(lanes.as_mut_ptr(), margin) };
-    lanes.into_iter().fold(Real::INFINITY, Real::min)
+    let lowest = |v: __m256d| {
+        let mut lanes = [0.0; 4];
+        // SAFETY: `lanes` holds four values.
+        unsafe { _mm256_storeu_pd(lanes.as_mut_ptr(), v) };
+        lanes.into_iter().fold(Real::INFINITY, Real::min)
+    };
+    Slack {
+        margin: lowest(margin),
+        per_lever: lowest(per_lever),
+    }
 }
 
 #[cfg(test)]
@@ -524,9 +608,24 @@ mod tests {
         let (mut o1, mut n1) = (vec![0; n], vec![0; n]);
         let (mut o2, mut n2) = (vec![], vec![]);
         let every = u64::first(n);
-        vertex_masks_scalar(&soa, d.planes(), every, tol, &mut o1, &mut n1);
+        let mut inverse = Vec::new();
+        inverse_levers(&soa, &Point3::new(0.3, -0.2, 0.1), &mut inverse);
+        let s1 = vertex_masks_scalar(&soa, &inverse, d.planes(), every, tol, &mut o1, &mut n1);
         let all = u128::first(points.len());
-        vertex_masks(&soa, d.planes(), every, tol, all, &mut o2, &mut n2);
+        let s2 = vertex_masks(
+            &soa,
+            &inverse,
+            d.planes(),
+            every,
+            tol,
+            all,
+            &mut o2,
+            &mut n2,
+        );
+        // The vector path fuses multiply–adds: the misses agree to round-off.
+        assert!((s1.margin - s2.margin).abs() < 1e-15);
+        assert!((s1.per_lever / s2.per_lever - 1.0).abs() < 1e-3);
+        assert!(s1.margin < 1e-12 && s1.per_lever > 0.0);
         let o1: Vec<u128> = o1.iter().map(|m| m & all).collect();
         let n1: Vec<u128> = n1.iter().map(|m| m & all).collect();
         assert_eq!(o1, o2);

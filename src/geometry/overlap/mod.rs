@@ -134,6 +134,9 @@ pub struct OverlapScratch {
     poly_tmp: Vec<Point3<Real>>,
     dist: Vec<Real>,
     points: Vec<Point3<Real>>,
+    /// Per vertex of A, and of B, the inverse distance from the plan's pivot.
+    inverse_lever_a: Vec<Real>,
+    inverse_lever_b: Vec<Real>,
     /// The labelled clipping's double buffer, and edges of B near A (topology).
     labelled: [Vec<topology::LabelledVertex>; 2],
     near_edges: Vec<[u32; 2]>,
@@ -181,12 +184,14 @@ pub fn overlap_with(
 /// may move from that pose before any of these decisions could change.
 ///
 /// # Invariant
-/// While B's vertices in A's frame, and A's vertices in B's frame, have moved less
-/// than `margin` since `rotation`/`translation`, every vertex–plane and ball–plane
-/// test of the bit-mask path comes out as it did there, so the kept plan *is* the
-/// plan of the current pose: [`overlap_cached`] then answers bit for bit what
-/// [`overlap`] answers, skipping only the tests. Shapes beyond the bit-mask path,
-/// and plans of more faces than fit, are not kept.
+/// While the vertices of each shape have moved relative to the other's planes by
+/// less than the slack allows since `rotation`/`translation`, every vertex–plane and
+/// ball–plane test of the bit-mask path comes out as it did there, so the kept plan
+/// *is* the plan of the current pose; where a topology is kept, B's edges have also
+/// moved less than their distance to A's, so it is the topology of the current pose.
+/// [`overlap_cached`] then answers bit for bit what [`overlap`] answers, skipping
+/// only the tests. Shapes beyond the bit-mask path, and plans of more faces than
+/// fit, are not kept.
 #[derive(Clone, Debug)]
 pub struct OverlapCache {
     /// The two shapes the plan is for (addresses): a pair whose particles were
@@ -194,8 +199,11 @@ pub struct OverlapCache {
     shapes: (usize, usize),
     rotation: Matrix3<Real>,
     translation: Vector3<Real>,
-    /// Negative: nothing kept.
-    margin: Real,
+    /// The point of B (B's frame) that lay midway between the centroids, the pivot of
+    /// `slack`.
+    pivot_in_b: Vector3<Real>,
+    /// How far the pair may move (see [`masked::Slack`]); `None`: nothing kept.
+    slack: Option<masked::Slack>,
     separated: bool,
     faces: [masked::PlannedFace; CACHED_FACES],
     of_a: u8,
@@ -219,7 +227,8 @@ impl Default for OverlapCache {
             shapes: (0, 0),
             rotation: Matrix3::identity(),
             translation: Vector3::zeros(),
-            margin: -1.0,
+            pivot_in_b: Vector3::zeros(),
+            slack: None,
             separated: false,
             faces: [masked::PlannedFace::default(); CACHED_FACES],
             of_a: 0,
@@ -232,31 +241,35 @@ impl Default for OverlapCache {
 }
 
 impl OverlapCache {
-    /// Whether the kept plan still holds at the pose (`rotation`, `translation`) of
-    /// B in A, for shapes of circumradii `ra` and `rb`.
+    /// Whether the kept decisions still hold at the pose (`rotation`, `translation`)
+    /// of B in A, for shapes whose overlap tolerance is `tol`.
     ///
-    /// A vertex w of B moves in A's frame by at most `|Δt| + ‖ΔR‖ |w|`, and a vertex v
-    /// of A moves in B's frame by at most `|Δt| + ‖ΔR‖ (|v| + |t₀|)`, so neither moves
-    /// more than `|Δt| + ‖ΔR‖ (max(ra, rb) + |t₀|)` relative to the other's planes
-    /// (and the ball–plane tests move less). For rotations the spectral norm `‖ΔR‖`
-    /// is the Frobenius norm over √2. A plane–normal sign test between flush faces
+    /// The relative motion since the kept pose moves B's material point at the pivot
+    /// `c` (midway between the centroids then) by `a`, and any other by at most `a +
+    /// ‖ΔR‖ L`, `L` its distance from `c` at the kept pose; this bounds how far the
+    /// vertices of either shape have moved relative to the other's planes, and B's
+    /// edges relative to A's. For rotations the spectral norm `‖ΔR‖` is the
+    /// Frobenius norm over √2. The tolerance is added to `a` for the round-off of
+    /// the distances at the new pose. A plane–normal sign test between flush faces
     /// (the only other decision) cannot flip without a turn of order one radian, far
-    /// beyond any margin.
+    /// beyond any slack.
     fn holds(
         &self,
         shapes: (usize, usize),
         rotation: &Matrix3<Real>,
         translation: &Vector3<Real>,
-        ra: Real,
-        rb: Real,
+        tol: Real,
     ) -> bool {
-        if self.margin <= 0.0 || shapes != self.shapes {
+        let Some(slack) = self.slack else {
+            return false;
+        };
+        if shapes != self.shapes {
             return false;
         }
         let turn = (rotation - self.rotation).norm() * std::f64::consts::FRAC_1_SQRT_2;
-        let drift =
-            (translation - self.translation).norm() + turn * (ra.max(rb) + self.translation.norm());
-        drift < self.margin
+        let pivot = 0.5 * self.translation;
+        let a = (rotation * self.pivot_in_b + translation - pivot).norm();
+        slack.holds(a + tol, turn)
     }
 
     /// Keeps the plan in `s`, and the topology `topology` read off it, for the pose
@@ -272,7 +285,7 @@ impl OverlapCache {
         translation: Vector3<Real>,
         s: &mut OverlapScratch,
     ) {
-        self.margin = -1.0;
+        self.slack = None;
         let plan = &s.plan;
         if plan.faces.len() > CACHED_FACES && topology.is_none() {
             return;
@@ -281,12 +294,14 @@ impl OverlapCache {
         self.rotation = rotation;
         self.translation = translation;
         self.separated = plan.separated;
-        let mut margin = plan.margin;
+        // The pivot, t/2, as a point of B.
+        self.pivot_in_b = rotation.transpose() * (-0.5 * translation);
+        let mut slack = plan.slack;
         match topology {
             Some(topology) => {
                 self.topology = Some(topology.clone());
                 (self.b_vertices, self.b_planes) = topology.b_parts_used();
-                margin = margin.min(topology::edge_margin(a, b, s));
+                slack = slack.min(topology::edge_slack(a, b, s));
             }
             None => {
                 self.topology = None;
@@ -296,8 +311,7 @@ impl OverlapCache {
                 (self.b_vertices, self.b_planes) = masked::b_parts_used(b, &plan.faces, plan.of_a);
             }
         }
-        // A distance at the new pose carries round-off well below the tolerance.
-        self.margin = margin - tolerance(a, b);
+        self.slack = Some(slack);
     }
 }
 
@@ -330,7 +344,7 @@ pub fn overlap_cached_with(
     }
     let rotation = b_in_a.rotation.to_rotation_matrix().into_inner();
     let shapes = (std::ptr::from_ref(a).addr(), std::ptr::from_ref(b).addr());
-    if cache.holds(shapes, &rotation, &t, a.circumradius(), b.circumradius()) {
+    if cache.holds(shapes, &rotation, &t, tolerance(a, b)) {
         // A kept separation needs not even B's vertices.
         if cache.separated {
             return None;

@@ -26,7 +26,7 @@
 
 use nalgebra::Point3;
 
-use super::masked::{FacePlan, bits};
+use super::masked::{FacePlan, Slack, bits};
 use super::{OverlapGeometry, OverlapScratch, Pieces, summarise};
 use crate::Real;
 use crate::geometry::polygon::cut;
@@ -431,27 +431,35 @@ fn edge_cut_label(
     })
 }
 
-/// The smallest distance between an edge of A and an edge of B that could meet:
-/// edges with both endpoints outside one plane of the other shape (by the plan's
-/// masks, which hold while the plan does) cannot. While the shapes move relative to
-/// each other by less than this, no edge crosses an edge.
-pub(super) fn edge_margin(
+/// The slack of the edge pairs that could meet: the smallest distance between an
+/// edge of A and an edge of B, and that distance per unit lever of B's edge (the
+/// farther endpoint from the plan's pivot, whose inverse distances are in `s`).
+/// Edges with both endpoints outside one plane of the other shape (by the plan's
+/// masks, which hold while the plan does) cannot meet. Within this slack no edge
+/// crosses an edge: the distance of two segments changes by no more than the
+/// farthest displacement of a point of the moving one.
+pub(super) fn edge_slack(
     a: &ConvexPolyhedron,
     b: &ConvexPolyhedron,
     s: &mut OverlapScratch,
-) -> Real {
+) -> Slack {
     let near_b = &mut s.near_edges;
     near_b.clear();
     near_b.extend(b.edges().iter().filter(|e| near(e, &s.out_b)));
-    let mut margin = Real::INFINITY;
+    let inverse = &s.inverse_lever_b;
+    let mut slack = Slack::NONE;
     for ea in a.edges().iter().filter(|e| near(e, &s.out_a)) {
         let (p0, p1) = (a.vertices()[ea[0] as usize], a.vertices()[ea[1] as usize]);
-        for eb in near_b.iter() {
-            let (q0, q1) = (s.b_points[eb[0] as usize], s.b_points[eb[1] as usize]);
-            margin = margin.min(segment_distance(&p0, &p1, &q0, &q1));
+        for &[u, w] in near_b.iter() {
+            let (q0, q1) = (s.b_points[u as usize], s.b_points[w as usize]);
+            let distance = segment_distance(&p0, &p1, &q0, &q1);
+            slack = slack.min(Slack {
+                margin: distance,
+                per_lever: distance * inverse[u as usize].min(inverse[w as usize]),
+            });
         }
     }
-    margin
+    slack
 }
 
 /// Whether edge `e` could meet the other shape: no plane of it has both endpoints
