@@ -501,7 +501,7 @@ fn vertex_masks_scalar(
     for k in bits(active) {
         let p = &planes[k];
         let (mut o, mut n) = (0u128, 0u128);
-        for v in 0..points.x.len() {
+        for (v, inverse) in inverse_lever.iter().enumerate() {
             let d = p.normal.x * points.x[v] + p.normal.y * points.y[v] + p.normal.z * points.z[v]
                 - p.offset;
             o |= ((d > tol) as u128) << v;
@@ -509,7 +509,7 @@ fn vertex_masks_scalar(
             let miss = (d.abs() - tol).abs();
             slack = slack.min(Slack {
                 margin: miss,
-                per_lever: miss * inverse_lever[v],
+                per_lever: miss * inverse,
             });
         }
         out[k] = o;
