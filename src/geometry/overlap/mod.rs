@@ -204,17 +204,29 @@ pub struct OverlapCache {
     pivot_in_b: Vector3<Real>,
     /// How far the pair may move (see [`masked::Slack`]); `None`: nothing kept.
     slack: Option<masked::Slack>,
-    separated: bool,
-    faces: [masked::PlannedFace; CACHED_FACES],
-    of_a: u8,
-    len: u8,
-    /// The intersection's topology where it has one: while it holds (the margin then
-    /// also covers edge–edge crossings) it is evaluated instead of clipping the plan.
-    topology: Option<Topology>,
     /// B's vertices and planes (bits) that clipping by the plan, or evaluating the
     /// topology, reads: only these are placed in A's frame while the plan holds.
     b_vertices: u128,
     b_planes: u64,
+    decisions: Kept,
+}
+
+/// What an [`OverlapCache`] keeps of a pose's decisions. One of them only: the cache
+/// of every candidate pair is read each step, and its size is memory traffic.
+#[derive(Clone, Debug)]
+enum Kept {
+    /// A face plane separates the shapes.
+    Separated,
+    /// The intersection's topology: while it holds (the slack then also covers
+    /// edge–edge crossings) it is evaluated instead of clipping.
+    Topology(Topology),
+    /// The faces of A (the first `of_a`), then of B, to clip, and the planes to clip
+    /// each by: for touching configurations, which have no topology.
+    Plan {
+        faces: [masked::PlannedFace; CACHED_FACES],
+        of_a: u8,
+        len: u8,
+    },
 }
 
 /// Most planned faces (of both shapes together) an [`OverlapCache`] keeps: a shallow
@@ -229,13 +241,9 @@ impl Default for OverlapCache {
             translation: Vector3::zeros(),
             pivot_in_b: Vector3::zeros(),
             slack: None,
-            separated: false,
-            faces: [masked::PlannedFace::default(); CACHED_FACES],
-            of_a: 0,
-            len: 0,
-            topology: None,
             b_vertices: 0,
             b_planes: 0,
+            decisions: Kept::Separated,
         }
     }
 }
@@ -293,24 +301,28 @@ impl OverlapCache {
         self.shapes = shapes;
         self.rotation = rotation;
         self.translation = translation;
-        self.separated = plan.separated;
         // The pivot, t/2, as a point of B.
         self.pivot_in_b = rotation.transpose() * (-0.5 * translation);
         let mut slack = plan.slack;
-        match topology {
+        (self.b_vertices, self.b_planes) = (0, 0);
+        self.decisions = match topology {
+            _ if plan.separated => Kept::Separated,
             Some(topology) => {
-                self.topology = Some(topology.clone());
                 (self.b_vertices, self.b_planes) = topology.b_parts_used();
                 slack = slack.min(topology::edge_slack(a, b, s));
+                Kept::Topology(topology.clone())
             }
             None => {
-                self.topology = None;
-                self.faces[..plan.faces.len()].copy_from_slice(&plan.faces);
-                self.of_a = plan.of_a as u8;
-                self.len = plan.faces.len() as u8;
+                let mut faces = [masked::PlannedFace::default(); CACHED_FACES];
+                faces[..plan.faces.len()].copy_from_slice(&plan.faces);
                 (self.b_vertices, self.b_planes) = masked::b_parts_used(b, &plan.faces, plan.of_a);
+                Kept::Plan {
+                    faces,
+                    of_a: plan.of_a as u8,
+                    len: plan.faces.len() as u8,
+                }
             }
-        }
+        };
         self.slack = Some(slack);
     }
 }
@@ -346,15 +358,18 @@ pub fn overlap_cached_with(
     let shapes = (std::ptr::from_ref(a).addr(), std::ptr::from_ref(b).addr());
     if cache.holds(shapes, &rotation, &t, tolerance(a, b)) {
         // A kept separation needs not even B's vertices.
-        if cache.separated {
+        if let Kept::Separated = cache.decisions {
             return None;
         }
         place_b_parts(b, &rotation, &t, cache.b_vertices, cache.b_planes, s);
-        if let Some(topology) = &cache.topology {
-            return topology.evaluate(a, &t, s);
-        }
-        let (of_a, len) = (cache.of_a as usize, cache.len as usize);
-        return masked::overlap_planned(a, b, &t, &cache.faces[..of_a], &cache.faces[of_a..len], s);
+        return match &cache.decisions {
+            Kept::Separated => None,
+            Kept::Topology(topology) => topology.evaluate(a, &t, s),
+            Kept::Plan { faces, of_a, len } => {
+                let (of_a, len) = (*of_a as usize, *len as usize);
+                masked::overlap_planned(a, b, &t, &faces[..of_a], &faces[of_a..len], s)
+            }
+        };
     }
     place_b(b, &rotation, &t, s);
     masked::plan_masked(a, b, &t, s);

@@ -292,6 +292,7 @@ impl Topology {
                 Kind::Unlabelled => unreachable!("a kept topology has every vertex labelled"),
             };
         }
+        let points = &points[..n];
         let mut pieces = Pieces::default();
         for f in &self.faces[..self.face_count as usize] {
             let entries = &self.loops[f.start as usize..(f.start + f.len) as usize];
@@ -300,9 +301,9 @@ impl Topology {
             } else {
                 a.planes()[f.face as usize].normal
             };
-            pieces.add_loop(&points[..n], entries, &normal, f.of_b);
+            pieces.add_loop(points, entries, &normal, f.of_b);
         }
-        summarise(&points[..n], &pieces, t)
+        summarise(points, &pieces, t)
     }
 }
 
