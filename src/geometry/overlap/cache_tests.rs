@@ -7,8 +7,8 @@ use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 
 use super::{
-    OverlapCache, OverlapGeometry, OverlapScratch, overlap, overlap_cached, overlap_cached_with,
-    overlap_with,
+    Kept, OverlapCache, OverlapGeometry, OverlapScratch, overlap, overlap_cached,
+    overlap_cached_with, overlap_with,
 };
 use crate::Real;
 use crate::geometry::{ConvexPolyhedron, generators};
@@ -47,21 +47,22 @@ fn small_vector(rng: &mut Pcg64, size: Real) -> Vector3<Real> {
 
 /// Walks B about A from a shallow overlap along `direction`, with steps of `step`
 /// metres and `turn` radians and now and then a jump; returns (kept, renewed,
-/// overlapping) step counts after checking every step bit for bit.
+/// overlapping, overlapping by a kept topology) step counts after checking every
+/// step bit for bit.
 fn walk(
     a: &ConvexPolyhedron,
     b: &ConvexPolyhedron,
     seed: u64,
     step: Real,
     turn: Real,
-) -> [usize; 3] {
+) -> [usize; 4] {
     let mut rng = Pcg64::seed_from_u64(seed);
     let reach = a.circumradius() + b.circumradius();
     let direction = small_vector(&mut rng, 1.0).normalize();
     let mut rotation = UnitQuaternion::from_scaled_axis(small_vector(&mut rng, 3.0));
     let mut translation = direction * 0.8 * reach;
     let mut cache = OverlapCache::default();
-    let mut counts = [0; 3];
+    let mut counts = [0; 4];
     // The kept path places only the parts of B its plan reads: its scratch is filled
     // with another pose's B before each step, so that a part it fails to place shows.
     let mut scratch = OverlapScratch::default();
@@ -87,6 +88,7 @@ fn walk(
         let kept = kept_before == (cache.translation, cache.slack) && cache.slack.is_some();
         counts[if kept { 0 } else { 1 }] += 1;
         counts[2] += fresh.is_some() as usize;
+        counts[3] += (fresh.is_some() && matches!(cache.decisions, Kept::Topology(_))) as usize;
     }
     counts
 }
@@ -98,7 +100,7 @@ fn kept_plans_answer_bit_for_bit() {
     let cube = generators::cuboid(0.01, 0.01, 0.01).unwrap();
     for (name, shape) in [("dodecahedron", &dodecahedron), ("prism", &prism)] {
         for seed in 0..4 {
-            let [kept, renewed, overlapping] = walk(shape, shape, seed, 1e-8, 1e-6);
+            let [kept, renewed, overlapping, by_topology] = walk(shape, shape, seed, 1e-8, 1e-6);
             // A slow walk keeps its plan most of the time, and renews it at the jumps
             // and whenever a vertex comes near a plane.
             assert!(
@@ -109,6 +111,11 @@ fn kept_plans_answer_bit_for_bit() {
             assert!(
                 overlapping > 100,
                 "{name} {seed}: overlapping {overlapping}"
+            );
+            // Away from touching, the overlap is evaluated from its topology.
+            assert!(
+                by_topology > overlapping / 2,
+                "{name} {seed}: {by_topology} of {overlapping} by topology"
             );
             // A fast one renews it often; the answers stay the same.
             walk(shape, shape, seed, 1e-5, 1e-3);

@@ -500,7 +500,106 @@ fn segment_distance(
 
 #[cfg(test)]
 mod tests {
+    use nalgebra::{UnitQuaternion, Vector3};
+    use rand::{Rng, SeedableRng};
+    use rand_pcg::Pcg64;
+
+    use super::super::{masked, place_b};
     use super::*;
+    use crate::geometry::generators;
+
+    /// Evaluating the topology gives what clipping the plan's faces gives, to
+    /// round-off, over shallow and deep overlaps of several shapes; and touching
+    /// faces have no topology.
+    #[test]
+    fn topology_and_clipping_agree() {
+        let shapes = [
+            generators::dodecahedron(0.005).unwrap(),
+            generators::prism(12, 0.004, 0.006).unwrap(),
+            generators::random_convex(30, 0.005, 0.3, 7).unwrap(),
+        ];
+        let mut rng = Pcg64::seed_from_u64(3);
+        let mut s = OverlapScratch::default();
+        // Shallow overlaps of the pellet shapes (centroids at least 0.88 of the sum
+        // of circumradii apart, as in granular contacts), with a topology, and deep
+        // ones that have too many vertices or faces to keep one. (The random hull has
+        // many small faces: a shallow contact can meet more than a topology keeps.)
+        let (mut shallow, mut shallow_with, mut without) = (0, 0, 0);
+        for (i, a) in shapes.iter().enumerate() {
+            for (j, b) in shapes.iter().enumerate() {
+                let pellets = i < 2 && j < 2;
+                for _ in 0..600 {
+                    let direction = Vector3::new(
+                        rng.random_range(-1.0..1.0),
+                        rng.random_range(-1.0..1.0),
+                        rng.random_range(-1.0..1.0),
+                    )
+                    .normalize();
+                    let reach = a.circumradius() + b.circumradius();
+                    let apart = rng.random_range(0.3..1.0);
+                    let t = direction * reach * apart;
+                    let axis = Vector3::new(
+                        rng.random_range(-3.0..3.0),
+                        rng.random_range(-3.0..3.0),
+                        rng.random_range(-3.0..3.0),
+                    );
+                    let rotation = UnitQuaternion::from_scaled_axis(axis).to_rotation_matrix();
+                    place_b(b, rotation.matrix(), &t, &mut s);
+                    masked::plan_masked(a, b, &t, &mut s);
+                    if s.plan.separated {
+                        continue;
+                    }
+                    let plan = std::mem::take(&mut s.plan);
+                    let topology = Topology::read(a, b, &plan, &mut s);
+                    if pellets && apart >= 0.88 {
+                        shallow += 1;
+                        shallow_with += topology.is_some() as usize;
+                    }
+                    let Some(topology) = topology else {
+                        s.plan = plan;
+                        without += 1;
+                        continue;
+                    };
+                    let (faces_a, faces_b) = plan.faces.split_at(plan.of_a);
+                    let clipped = masked::overlap_planned(a, b, &t, faces_a, faces_b, &mut s);
+                    let evaluated = topology.evaluate(a, &t, &s);
+                    s.plan = plan;
+                    let (Some(c), Some(e)) = (clipped, evaluated) else {
+                        assert!(clipped.is_none() && evaluated.is_none());
+                        continue;
+                    };
+                    let size = a.circumradius();
+                    let area = size * size;
+                    assert!((c.volume - e.volume).abs() <= 1e-12 * size.powi(3));
+                    assert!((c.centroid - e.centroid).norm() <= 1e-11 * size);
+                    assert!((c.area_vector() - e.area_vector()).norm() <= 1e-11 * area);
+                    assert!((c.depth - e.depth).abs() <= 1e-11 * size);
+                    let moment = area * size;
+                    assert!(
+                        (c.rotation_gradient_a - e.rotation_gradient_a).norm() <= 1e-11 * moment
+                    );
+                    assert!(
+                        (c.rotation_gradient_b - e.rotation_gradient_b).norm() <= 1e-11 * moment
+                    );
+                }
+            }
+        }
+        // Random poses are in general position: every shallow overlap has a topology.
+        assert!(
+            shallow > 60 && shallow_with == shallow,
+            "{shallow_with} of {shallow}"
+        );
+        assert!(without > 100, "{without} without");
+
+        // Cubes face to face: their vertices lie on each other's planes.
+        let cube = generators::cuboid(0.01, 0.01, 0.01).unwrap();
+        let t = Vector3::new(0.0099, 0.002, 0.0);
+        place_b(&cube, &nalgebra::Matrix3::identity(), &t, &mut s);
+        masked::plan_masked(&cube, &cube, &t, &mut s);
+        let plan = std::mem::take(&mut s.plan);
+        assert!(!plan.separated);
+        assert!(Topology::read(&cube, &cube, &plan, &mut s).is_none());
+    }
 
     #[test]
     fn segment_distance_of_crossing_skew_and_parallel_segments() {
