@@ -6,8 +6,7 @@
 //! The boundary of the intersection `A ∩ B` consists of the pieces `f ∩ B` of the
 //! faces `f` of A and the pieces `g ∩ A` of the faces `g` of B. Each piece is a convex
 //! polygon, obtained by clipping one face polygon against the other solid's planes
-//! (Sutherland–Hodgman in 3-D). No topology of the intersection is ever built: the
-//! closed set of polygons is enough for
+//! (Sutherland–Hodgman in 3-D). The closed set of polygons is enough for
 //!
 //! - the volume and centroid (a fan of tetrahedra from a point near the overlap);
 //! - the contact-area vector `S = Σ_{f ∈ A} n_f |f ∩ B|`, which is exactly the gradient
@@ -17,11 +16,12 @@
 //!
 //! We chose this over the primary seed's dual-space incremental quickhull because it
 //! needs no point strictly inside the intersection (the polar dual does, and finding
-//! one for a tiny overlap is itself a linear program), has no combinatorial state that
-//! round-off can corrupt (a hull's horizon can), allocates nothing per pair (the
-//! scratch buffers are reused), and parallelises as a flat loop over faces. The cost is
-//! dominated by one matrix of vertex–plane distances per side, and most faces are
-//! rejected from that matrix alone.
+//! one for a tiny overlap is itself a linear program), builds its combinatorial state
+//! from sign tests alone rather than maintaining it through round-off (a hull's
+//! horizon can be corrupted), allocates nothing per pair (the scratch buffers are
+//! reused), and parallelises as a flat loop over faces. The cost is dominated by one
+//! matrix of vertex–plane distances per side, and most faces are rejected from that
+//! matrix alone.
 //!
 //! Coplanar faces of equal orientation (identical shapes at the same pose, boxes of a
 //! lattice lying flush) would be counted twice; the piece from B is dropped in that
@@ -37,10 +37,17 @@
 //! separating face plane.
 //!
 //! The bit-mask path separates deciding (which faces bound the intersection, and
-//! which planes cut each) from clipping. A pair evaluated step after step keeps its
-//! decisions in an [`OverlapCache`] with the distance by which the closest test
-//! missed; until the pair has moved that far, the decisions cannot change and only
-//! the clipping is done again ([`overlap_cached`]), with the same answer bit for bit.
+//! which planes cut each) from clipping, and the clipping from evaluating: a
+//! labelled clipping records what every vertex of `A ∩ B` lies on (a vertex of one
+//! shape, or an edge of one shape cut by a plane of the other) and the loop of
+//! vertices of each face, its [`topology`]; the geometry is then evaluated from it,
+//! each vertex by one edge cut. A pair evaluated step after step keeps these
+//! decisions in an [`OverlapCache`] with how far the closest test was from going the
+//! other way (vertex–plane tests, and edge–edge distances for the topology); until
+//! the pair has moved that far, they cannot change, and only the evaluation is done
+//! again ([`overlap_cached`]), with the same answer bit for bit. Touching
+//! configurations (vertices within the tolerance of a plane, flush faces) have no
+//! topology and keep the plan, whose faces are clipped again each step.
 //!
 //! For larger meshes (icospheres of hundreds to tens of thousands of facets) only faces
 //! whose bounding spheres meet the box `R` enclosing both bounding spheres take part,
