@@ -137,11 +137,19 @@ fn overlap_with_prism(
     starts.clear();
     starts.push(0);
 
-    // Faces of the particle clipped to the prism.
+    // Faces of the particle clipped to the prism; a face wholly in front of the
+    // facet plane has nothing behind it.
     let mut grad_p = Vector3::zeros();
     let mut rot_p = Vector3::zeros();
     for f in 0..poly.face_count() {
-        clipped.set(poly.face(f).iter().map(|&v| poly.vertices()[v as usize]));
+        let face = poly.face(f);
+        if face
+            .iter()
+            .all(|&v| facet.distance(&poly.vertices()[v as usize]) >= 0.0)
+        {
+            continue;
+        }
+        clipped.set(face.iter().map(|&v| poly.vertices()[v as usize]));
         for plane in planes {
             clipped.clip(plane);
             if clipped.is_degenerate() {
@@ -159,18 +167,22 @@ fn overlap_with_prism(
         return None;
     }
 
-    // Faces of the prism clipped to the particle: the facet itself, then the three
-    // sides, deep enough to reach below the particle.
+    // The prism's sides clipped to the particle, deep enough to reach below it; a
+    // side whose plane has the whole particle inside does not meet it. The facet
+    // itself (the cap) is not needed: the cones are drawn from a point on its plane,
+    // and its vector area closes the surface.
     let reach = max_depth * (1.0 + 1e-6) + 1e-9 * poly.circumradius();
-    let mut section_area = 0.0;
-    let mut grad_q = Vector3::zeros();
-    for side in 0..4 {
-        if side == 0 {
-            clipped.set(tri.iter().copied());
-        } else {
-            let (a, b) = (tri[side - 1], tri[side % 3]);
-            clipped.set([a, a - n * reach, b - n * reach, b].into_iter());
+    let mut grad_sides = Vector3::zeros();
+    for side in 1..4 {
+        if poly
+            .vertices()
+            .iter()
+            .all(|v| planes[side].distance(v) <= 0.0)
+        {
+            continue;
         }
+        let (a, b) = (tri[side - 1], tri[side % 3]);
+        clipped.set([a, a - n * reach, b - n * reach, b].into_iter());
         for plane in poly.planes() {
             clipped.clip(plane);
             if clipped.is_degenerate() {
@@ -178,20 +190,16 @@ fn overlap_with_prism(
             }
         }
         if !clipped.is_degenerate() {
-            let area = vector_area(clipped.points());
-            if side == 0 {
-                section_area = area.norm();
-            }
-            grad_q += area;
+            grad_sides += vector_area(clipped.points());
             points.extend_from_slice(clipped.points());
             starts.push(points.len());
         }
     }
 
-    let origin = Point3::from(
+    let mean = Point3::from(
         points.iter().fold(Vector3::zeros(), |a, p| a + p.coords) / points.len() as Real,
     );
-    let mut cone = ConeSums::new(origin);
+    let mut cone = ConeSums::new(mean - n * facet.distance(&mean));
     for w in starts.windows(2) {
         cone.add_polygon(&points[w[0]..w[1]]);
     }
@@ -206,11 +214,12 @@ fn overlap_with_prism(
     Some(FacetOverlap {
         volume,
         centroid: cone.centroid(),
-        // ∂V/∂x_P = S_P = −S_Q; average the two for symmetry of round-off.
-        volume_gradient: 0.5 * (grad_p - grad_q),
+        // ∂V/∂x_P = S_P.
+        volume_gradient: grad_p,
         rotation_gradient: rot_p,
         depth,
-        section_area,
+        // The cap closes the surface: its vector area is −(S_P + S_sides).
+        section_area: (grad_p + grad_sides).norm(),
         facet_normal: n,
     })
 }
