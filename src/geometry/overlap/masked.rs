@@ -415,14 +415,23 @@ fn face_cut<M: VertexSet>(own: &MaskedSide<M>, other: &MaskedSide<M>, f: usize) 
 }
 
 /// Planes (bits) whose outside the ball (`centre`, `radius`) reaches to within `tol`,
-/// and by how much the closest call missed the threshold.
+/// and by how much the closest of the others missed it.
+///
+/// Only the planes left out need a margin: their vertex tests are skipped on the
+/// strength of this one. A reached plane whose ball later falls short has every
+/// vertex more than `tol` inside, so its masks are empty and every decision comes
+/// out as if it had not been reached; its vertex tests are in the plan's slack.
 fn planes_reached(planes: &[Plane], centre: &Point3<Real>, radius: Real, tol: Real) -> (u64, Real) {
     planes
         .iter()
         .enumerate()
         .fold((0, Real::INFINITY), |(m, margin), (k, p)| {
             let reach = p.distance(centre) + radius + tol;
-            (m | ((reach >= 0.0) as u64) << k, margin.min(reach.abs()))
+            if reach >= 0.0 {
+                (m | 1 << k, margin)
+            } else {
+                (m, margin.min(-reach))
+            }
         })
 }
 
