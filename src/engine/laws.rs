@@ -10,8 +10,8 @@
 //! calibration is the costly part, are kept for every restitution seen.
 
 use std::borrow::Cow;
-use std::collections::HashMap;
 
+use super::fast_hash::FastMap;
 use crate::Real;
 use crate::contact::{DampingTable, PairStiffness};
 use crate::world::World;
@@ -40,8 +40,9 @@ pub(super) struct PairLaw {
 pub(super) struct ContactLaws {
     /// Calibrated damping, one table per restitution value.
     tables: Vec<DampingTable>,
-    /// Index into `tables` by the restitution's bit pattern.
-    table_of: HashMap<u64, usize>,
+    /// Index into `tables` by the restitution's bit pattern (looked up per wall
+    /// contact every step).
+    table_of: FastMap<u64, usize>,
     /// Row-major over (type of body 1, type of body 2).
     pairs: Vec<PairLaw>,
     types: usize,
