@@ -146,6 +146,7 @@ pub struct OverlapScratch {
     inverse_lever_b: Vec<Real>,
     /// The labelled clipping's double buffer, and edges of B near A (topology).
     labelled: [Vec<topology::LabelledVertex>; 2],
+    labelled_distances: Vec<Real>,
     near_edges: Vec<[u32; 2]>,
 }
 

@@ -180,7 +180,14 @@ impl Topology {
                 (&side_b, &side_a)
             };
             let face = planned.face();
-            let poly = clip_labelled(own, other, face, planned.planes(), &mut s.labelled)?;
+            let poly = clip_labelled(
+                own,
+                other,
+                face,
+                planned.planes(),
+                &mut s.labelled,
+                &mut s.labelled_distances,
+            )?;
             if poly.len() < 3 {
                 continue;
             }
@@ -326,6 +333,7 @@ fn clip_labelled<'p>(
     face: usize,
     cut_planes: u64,
     buffers: &'p mut [Vec<LabelledVertex>; 2],
+    distances: &mut Vec<Real>,
 ) -> Option<&'p [LabelledVertex]> {
     let loop_ = own.shape.face(face);
     let [poly, output] = buffers;
@@ -349,11 +357,17 @@ fn clip_labelled<'p>(
     }));
     for h in bits(cut_planes) {
         let plane = &other.planes[h];
+        distances.clear();
+        distances.extend(poly.iter().map(|v| plane.distance(&v.point)));
+        // A plane with the whole polygon inside leaves it as it is.
+        if distances.iter().all(|&d| d <= 0.0) {
+            continue;
+        }
         let n = poly.len();
         output.clear();
         for k in 0..n {
             let (p, q) = (&poly[k], &poly[(k + 1) % n]);
-            let (dp, dq) = (plane.distance(&p.point), plane.distance(&q.point));
+            let (dp, dq) = (distances[k], distances[(k + 1) % n]);
             if dp <= 0.0 {
                 output.push(*p);
                 if dq > 0.0 {
