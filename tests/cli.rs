@@ -147,4 +147,24 @@ fn bench_runs_on_part_of_the_shipped_settled_bed() {
         let contacts: f64 = fields[n - 5].parse().unwrap();
         assert!(contacts > 500.0, "{row}");
     }
+
+    // One scene on one thread count: one row.
+    let (ok, out, err) = talus(&[
+        "bench",
+        "--scale",
+        "0.05",
+        "--steps",
+        "2",
+        "--scene",
+        "a",
+        "--threads",
+        "2",
+    ]);
+    assert!(ok, "{err}");
+    let rows: Vec<&str> = out.lines().filter(|l| l.starts_with('(')).collect();
+    assert_eq!(rows.len(), 1, "{out}");
+    assert!(rows[0].starts_with("(a)") && rows[0].split_whitespace().nth(5) == Some("2"));
+    // A scene that does not exist is named in the error.
+    let (ok, _, err) = talus(&["bench", "--scene", "d"]);
+    assert!(!ok && err.contains("--scene d"), "{err}");
 }
