@@ -141,15 +141,8 @@ fn overlap_with_prism(
     // facet plane has nothing behind it.
     let mut grad_p = Vector3::zeros();
     let mut rot_p = Vector3::zeros();
-    for f in 0..poly.face_count() {
-        let face = poly.face(f);
-        if face
-            .iter()
-            .all(|&v| facet.distance(&poly.vertices()[v as usize]) >= 0.0)
-        {
-            continue;
-        }
-        clipped.set(face.iter().map(|&v| poly.vertices()[v as usize]));
+    for f in faces_behind(poly, &facet) {
+        clipped.set(poly.face(f).iter().map(|&v| poly.vertices()[v as usize]));
         for plane in planes {
             clipped.clip(plane);
             if clipped.is_degenerate() {
@@ -224,6 +217,19 @@ fn overlap_with_prism(
     })
 }
 
+/// The faces of the particle with a vertex behind the facet plane: the others have
+/// nothing in the prism.
+fn faces_behind<'a>(
+    poly: &'a ConvexPolyhedron,
+    facet: &'a Plane,
+) -> impl Iterator<Item = usize> + 'a {
+    (0..poly.face_count()).filter(move |&f| {
+        poly.face(f)
+            .iter()
+            .any(|&v| facet.distance(&poly.vertices()[v as usize]) < 0.0)
+    })
+}
+
 /// Whether the particle lies within the facet's side planes (`sides`), so that the
 /// prism cuts it only by the facet plane: the common case of a pellet on a facet
 /// much larger than itself.
@@ -254,15 +260,8 @@ fn overlap_with_half_space(
     let on_plane = Point3::from(-n * facet.distance(&Point3::origin()));
     let mut cone = ConeSums::new(on_plane);
     let (mut area, mut moment) = (Vector3::zeros(), Vector3::zeros());
-    for f in 0..poly.face_count() {
-        let face = poly.face(f);
-        if face
-            .iter()
-            .all(|&v| facet.distance(&poly.vertices()[v as usize]) >= 0.0)
-        {
-            continue;
-        }
-        clipped.set(face.iter().map(|&v| poly.vertices()[v as usize]));
+    for f in faces_behind(poly, facet) {
+        clipped.set(poly.face(f).iter().map(|&v| poly.vertices()[v as usize]));
         clipped.clip(facet);
         if !clipped.is_degenerate() {
             area += vector_area(clipped.points());

@@ -617,38 +617,38 @@ mod tests {
 
     #[test]
     fn segment_distance_of_crossing_skew_and_parallel_segments() {
-        let p = |x, y, z| Point3::new(x, y, z);
-        // Skew, closest points inside both: the gap along z.
-        let d = segment_distance(
-            &p(-1., 0., 0.),
-            &p(1., 0., 0.),
-            &p(0., -1., 0.5),
-            &p(0., 1., 0.5),
-        );
-        assert!((d - 0.5).abs() < 1e-15);
-        // Closest approach beyond the end of the second: endpoint to segment.
-        let d = segment_distance(
-            &p(-1., 0., 0.),
-            &p(1., 0., 0.),
-            &p(3., -1., 0.),
-            &p(3., 1., 0.),
-        );
-        assert!((d - 2.0).abs() < 1e-15);
-        // Parallel, overlapping in extent.
-        let d = segment_distance(
-            &p(0., 0., 0.),
-            &p(2., 0., 0.),
-            &p(1., 0.3, 0.),
-            &p(3., 0.3, 0.),
-        );
-        assert!((d - 0.3).abs() < 1e-15);
-        // Parallel, apart along their line.
-        let d = segment_distance(
-            &p(0., 0., 0.),
-            &p(1., 0., 0.),
-            &p(4., 0., 0.),
-            &p(5., 0., 0.),
-        );
-        assert!((d - 3.0).abs() < 1e-15);
+        let cases = [
+            // Skew, closest points inside both: the gap along z.
+            (
+                [-1., 0., 0.],
+                [1., 0., 0.],
+                [0., -1., 0.5],
+                [0., 1., 0.5],
+                0.5,
+            ),
+            // Closest approach beyond the end of the second: endpoint to segment.
+            (
+                [-1., 0., 0.],
+                [1., 0., 0.],
+                [3., -1., 0.],
+                [3., 1., 0.],
+                2.0,
+            ),
+            // Parallel, overlapping in extent.
+            (
+                [0., 0., 0.],
+                [2., 0., 0.],
+                [1., 0.3, 0.],
+                [3., 0.3, 0.],
+                0.3,
+            ),
+            // Parallel, apart along their line.
+            ([0., 0., 0.], [1., 0., 0.], [4., 0., 0.], [5., 0., 0.], 3.0),
+        ];
+        for (p0, p1, q0, q1, expected) in cases {
+            let [p0, p1, q0, q1] = [p0, p1, q0, q1].map(Point3::from);
+            let d = segment_distance(&p0, &p1, &q0, &q1);
+            assert!((d - expected).abs() < 1e-15, "{d} vs {expected}");
+        }
     }
 }
