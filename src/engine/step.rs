@@ -345,6 +345,7 @@ impl Engine {
         let wall_results: Vec<Vec<WallContact>> = (0..w.particles.len())
             .into_par_iter()
             .with_min_len(WALL_PARTICLES_PER_TASK)
+            .with_max_len(WALL_PARTICLES_MAX_PER_TASK)
             .map(|i| {
                 if w.particles.frozen[i] {
                     Vec::new()
@@ -395,6 +396,11 @@ impl Engine {
 /// is smaller: with 256, a bed of 1000 pellets kept 16 cores to 4 tasks.
 const PARTICLES_PER_TASK: usize = 256;
 const WALL_PARTICLES_PER_TASK: usize = 32;
+/// Largest share of particles one wall task takes. The particles touching a wall
+/// are bunched (a bed sorted by height has its whole floor layer first), and rayon
+/// splits a range only as far as idle threads steal from it: without a cap one
+/// thread was left with the floor (2 threads scaled the wall stage by 1.5×).
+const WALL_PARTICLES_MAX_PER_TASK: usize = 256;
 const PAIRS_PER_TASK: usize = 64;
 
 /// Default regularisation length: below this fraction of the smaller equivalent
