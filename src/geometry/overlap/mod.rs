@@ -518,15 +518,9 @@ impl Pieces {
         flush: bool,
         points: &mut Vec<Point3<Real>>,
     ) {
-        self.add_sums(poly, normal, of_b, flush);
-        points.extend_from_slice(poly);
-    }
-
-    /// [`Pieces::add`] without keeping the vertices.
-    #[inline]
-    fn add_sums(&mut self, poly: &[Point3<Real>], normal: &Vector3<Real>, of_b: bool, flush: bool) {
         let sums = self.surface.add_piece(poly, normal);
         self.add_to_side(sums, of_b, flush);
+        points.extend_from_slice(poly);
     }
 
     /// Adds a piece whose vertices are `points[loop_[k]]`, of a face of A or, with
