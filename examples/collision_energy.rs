@@ -9,7 +9,7 @@
 
 use nalgebra::{Point3, UnitQuaternion, Vector3};
 use talus::contact::Material;
-use talus::engine::step::Engine;
+use talus::engine::{Backend, CpuBackend};
 use talus::geometry::{Shape, generators};
 use talus::world::{BodyType, Wall, World};
 fn main() {
@@ -59,8 +59,8 @@ fn main() {
         );
         world.particles.velocity[1] = Vector3::new(0.0, 0.0, -0.5);
     }
-    let mut engine = Engine::new(dt);
-    engine.initialise(&mut world);
+    let (mut engine, engine_dt) = (CpuBackend::default(), dt);
+    engine.initialise(&mut world, engine_dt);
     let mass = world.body_types[0].mass;
     let energy = |w: &World| {
         w.kinetic_energy()
@@ -74,13 +74,13 @@ fn main() {
     let e0 = energy(&world);
     let steps = (0.1 / dt) as usize;
     for k in 0..steps {
-        engine.step(&mut world);
-        if k % (steps / 2000) == 0 && engine.contacts > 0 {
+        engine.step(&mut world, engine_dt);
+        if k % (steps / 2000) == 0 && engine.stats().contacts > 0 {
             println!(
                 "t {:.4} E/E0 {:.6} contacts {} z {:.4e}",
                 world.time,
                 energy(&world) / e0,
-                engine.contacts,
+                engine.stats().contacts,
                 world.particles.position[0].z
             );
         }

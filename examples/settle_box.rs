@@ -8,7 +8,7 @@
 //! contact (period ~8 µs here); a suggested time step is still to be built.
 use nalgebra::{Point3, UnitQuaternion, Vector3};
 use talus::contact::Material;
-use talus::engine::step::Engine;
+use talus::engine::{Backend, CpuBackend};
 use talus::geometry::{Shape, generators};
 use talus::world::{BodyType, Wall, World};
 
@@ -125,14 +125,14 @@ fn main() {
             }
         }
     }
-    let mut engine = Engine::new(dt);
-    engine.initialise(&mut world);
+    let (mut engine, engine_dt) = (CpuBackend::default(), dt);
+    engine.initialise(&mut world, engine_dt);
     let t0 = std::time::Instant::now();
     let steps = (1.0 / dt) as usize;
     let mut contact_steps = 0usize;
     for step in 0..steps {
-        engine.step(&mut world);
-        contact_steps += engine.contacts;
+        engine.step(&mut world, engine_dt);
+        contact_steps += engine.stats().contacts;
         if step % (steps / 20) == 0 {
             let vmax = world
                 .particles
@@ -157,7 +157,7 @@ fn main() {
                 world.time,
                 vmax,
                 zmin,
-                engine.contacts,
+                engine.stats().contacts,
                 out,
                 world.kinetic_energy()
             );

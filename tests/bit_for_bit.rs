@@ -8,6 +8,7 @@
 //! `TALUS_PRINT_CHECKSUMS=1 cargo test --test bit_for_bit -- --nocapture` and says
 //! in the commit why the bits moved.
 
+use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -27,19 +28,34 @@ const CASES: [Case; 3] = [
         name: "settling_box",
         scene: "examples/settling_box/scene.toml",
         end_time: 0.04,
-        checksums: [0x9e67ff0815da3557, 0xd6fa5b7a1076ff8d, 0x22fa1b300583c2c0, 0xf2e069411190f078],
+        checksums: [
+            0x9e67ff0815da3557,
+            0xd6fa5b7a1076ff8d,
+            0x22fa1b300583c2c0,
+            0xf2e069411190f078,
+        ],
     },
     Case {
         name: "drum_quasi2d",
         scene: "examples/drum/quasi2d.toml",
         end_time: 0.03,
-        checksums: [0x17ed34423bde0539, 0xb65e1ed59af58ef2, 0xee638a32aac71c74, 0xa3772ce5a755aae5],
+        checksums: [
+            0x17ed34423bde0539,
+            0xb65e1ed59af58ef2,
+            0xee638a32aac71c74,
+            0xa3772ce5a755aae5,
+        ],
     },
     Case {
         name: "fixed_bed",
         scene: "examples/fixed_bed/scene.toml",
         end_time: 0.03,
-        checksums: [0xfc1c6885498302df, 0xefc9884127a25b85, 0x660383da9a42c070, 0xd333eb6e3973348f],
+        checksums: [
+            0xfc1c6885498302df,
+            0xefc9884127a25b85,
+            0x660383da9a42c070,
+            0xd333eb6e3973348f,
+        ],
     },
 ];
 
@@ -121,14 +137,16 @@ fn final_state(case: &Case, dir: &Path) -> u64 {
         .unwrap();
     pool.install(|| {
         let mut sim = Simulation::new(&scene);
-        let dt = sim.engine.dt;
-        while !sim.is_finished() && !sim.is_settled() {
-            sim.engine.dt = dt.min(sim.end_time - sim.time());
-            sim.step();
-            sim.engine.dt = dt;
-        }
+        let end = sim.end_time;
+        let _ = sim.advance_to(end, |sim, _| {
+            if sim.is_settled() {
+                ControlFlow::Break(())
+            } else {
+                ControlFlow::Continue(())
+            }
+        });
         let mut w = StateWriter::default();
-        sim.write_state(0, &mut w);
+        sim.snapshot().write(0, &mut w);
         fnv1a(&w.into_bytes())
     })
 }
@@ -143,7 +161,10 @@ fn examples_run_as_before() {
         let state = final_state(case, &dir);
         let found = [walls, series, frame, state];
         if print {
-            println!("{}: checksums: [{:#x}, {:#x}, {:#x}, {:#x}]", case.name, walls, series, frame, state);
+            println!(
+                "{}: checksums: [{:#x}, {:#x}, {:#x}, {:#x}]",
+                case.name, walls, series, frame, state
+            );
         }
         for (what, (f, e)) in ["walls.csv", "series.csv", "last frame", "final state"]
             .iter()

@@ -157,10 +157,7 @@ fn steps_land_on_the_communication_points() {
     let sim = c.simulation().unwrap();
     // 1 + 3 + ceil(1e-3/dt) + 1 DEM steps.
     assert_eq!(sim.steps, 1 + 3 + (1e-3 / dt).ceil() as u64 + 1);
-    assert_eq!(
-        sim.engine.dt, dt,
-        "the shortened last step does not change dt"
-    );
+    assert_eq!(sim.dt(), dt, "the shortened last step does not change dt");
 }
 
 /// The mean wall force over a step is the momentum the particles exchanged with the
@@ -170,7 +167,7 @@ fn mean_wall_force_is_the_impulse_the_particles_received() {
     let mut c = started("drum.toml");
     set_spin(&mut c, 3.0);
     let momentum = |c: &Component| -> (Vector3<f64>, f64) {
-        let w = &c.simulation().unwrap().world;
+        let w = c.simulation().unwrap().world();
         let p = &w.particles;
         (0..p.len()).fold((Vector3::zeros(), 0.0), |(sum, m), i| {
             let mass = w.body_types[p.body_type[i] as usize].mass;

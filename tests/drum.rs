@@ -93,10 +93,10 @@ fn run(sim: &mut Simulation, drum: &Drum, from: Real, until: Real) -> Means {
     while sim.time() < until {
         sim.step();
         if sim.time() > from {
-            let dt = sim.engine.dt;
-            let (drive, _, power) = drum.torques(&sim.world);
+            let dt = sim.dt();
+            let (drive, _, power) = drum.torques(&sim.world());
             m.drive += drive * dt;
-            m.moment += drum.gravity_moment(&sim.world) * dt;
+            m.moment += drum.gravity_moment(&sim.world()) * dt;
             m.power += power * dt;
             span += dt;
         }
@@ -171,7 +171,7 @@ fn no_particle_leaves_the_drum_in_five_revolutions_at_45_rpm() {
         sim.step();
         steps += 1;
         if steps % 50 == 0 || sim.time() >= end {
-            let p = &sim.world.particles;
+            let p = &sim.world().particles;
             assert_eq!(p.len(), n);
             for (i, x) in p.position.iter().enumerate() {
                 assert!(x.iter().all(|c| c.is_finite()), "particle {i} at {x}");
@@ -224,7 +224,7 @@ fn attached_walls_move_with_their_leader() {
     for _ in 0..100 {
         sim.step();
     }
-    let w = &sim.world.walls;
+    let w = &sim.world().walls;
     for cap in &w[1..] {
         assert_eq!(cap.pose, w[0].pose);
         assert_eq!(cap.angular_velocity, w[0].angular_velocity);

@@ -5,6 +5,7 @@
 
 use std::path::Path;
 
+use talus::engine::StepParams;
 use talus::scene::{Scene, Simulation};
 
 /// Dodecahedra and spheres poured by an inlet into a slowly turning closed drum
@@ -72,8 +73,10 @@ count = 40
 fn run(skin: Option<f64>, steps: usize) -> Simulation {
     let scene = Scene::parse(SCENE, Path::new("drum.toml")).expect("valid scene");
     let mut sim = Simulation::new(&scene);
-    sim.engine.neighbours.skin = skin;
-    sim.engine.neighbours.invalidate();
+    sim.set_params(StepParams {
+        skin,
+        ..sim.params()
+    });
     for _ in 0..steps {
         sim.step();
     }
@@ -85,37 +88,40 @@ fn kept_lists_give_the_same_run_as_lists_rebuilt_every_step() {
     let steps = 5000;
     let kept = run(None, steps);
     let rebuilt = run(Some(0.0), steps);
-    let (a, b) = (&kept.world.particles, &rebuilt.world.particles);
+    let (a, b) = (&kept.world().particles, &rebuilt.world().particles);
     assert!(a.len() > 40, "the inlet added its beads: {}", a.len());
     assert_eq!(a.len(), b.len());
     assert!(
-        kept.engine.contacts > 20,
+        kept.stats().contacts > 20,
         "{} contacts",
-        kept.engine.contacts
+        kept.stats().contacts
     );
     assert_eq!(a.id, b.id);
     assert_eq!(a.position, b.position);
     assert_eq!(a.orientation, b.orientation);
     assert_eq!(a.velocity, b.velocity);
     assert_eq!(a.angular_momentum, b.angular_momentum);
-    for (w, v) in kept.world.walls.iter().zip(&rebuilt.world.walls) {
+    for (w, v) in kept.world().walls.iter().zip(&rebuilt.world().walls) {
         assert_eq!(w.force, v.force, "{}", w.name);
         assert_eq!(w.torque, v.torque, "{}", w.name);
     }
-    assert_eq!(kept.engine.history(), rebuilt.engine.history());
+    assert_eq!(
+        kept.backend().contact_history(),
+        rebuilt.backend().contact_history()
+    );
     // Rebuilding every step is what skin 0 means; the kept lists last many steps.
-    assert_eq!(rebuilt.engine.neighbours.builds(), steps as u64 + 1);
-    let builds = kept.engine.neighbours.builds();
+    assert_eq!(rebuilt.stats().list_builds, steps as u64 + 1);
+    let builds = kept.stats().list_builds;
     println!(
         "{} particles, {} contacts, {} / {} candidate pairs, {builds} builds in {steps} steps",
         a.len(),
-        kept.engine.contacts,
-        kept.engine.candidate_pairs(),
-        rebuilt.engine.candidate_pairs()
+        kept.stats().contacts,
+        kept.stats().candidate_pairs,
+        rebuilt.stats().candidate_pairs
     );
     assert!(
         builds * 5 < steps as u64,
         "{builds} builds in {steps} steps"
     );
-    assert!(kept.engine.candidate_pairs() >= rebuilt.engine.candidate_pairs());
+    assert!(kept.stats().candidate_pairs >= rebuilt.stats().candidate_pairs);
 }

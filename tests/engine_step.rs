@@ -4,7 +4,7 @@
 
 use nalgebra::{Point3, UnitQuaternion, Vector3};
 use talus::contact::Material;
-use talus::engine::step::Engine;
+use talus::engine::{Backend, CpuBackend};
 use talus::geometry::{Shape, generators};
 use talus::world::{BodyType, Wall, World};
 
@@ -70,10 +70,10 @@ fn sphere_at_rest_on_a_floor_carries_its_weight() {
         UnitQuaternion::identity(),
         1,
     );
-    let mut engine = Engine::new(1e-5);
-    engine.initialise(&mut world);
+    let (mut engine, engine_dt) = (CpuBackend::default(), 1e-5);
+    engine.initialise(&mut world, engine_dt);
     for _ in 0..30_000 {
-        engine.step(&mut world);
+        engine.step(&mut world, engine_dt);
     }
     let t = &world.body_types[0];
     let v = world.particles.velocity[0].norm();
@@ -82,7 +82,7 @@ fn sphere_at_rest_on_a_floor_carries_its_weight() {
     // Solve κ A(δ) V(δ)^{1/3} = m g for δ (κ = 2 E*/R, E* = E/2 for equal materials).
     // The static overlap falls in the regularised range of the law.
     let kappa = 1e8 / r;
-    let v0 = (talus::engine::step::REGULARISATION_LENGTH * r).powi(3);
+    let v0 = (talus::engine::REGULARISATION_LENGTH * r).powi(3);
     let force = |d: f64| {
         let a = std::f64::consts::PI * (2.0 * r * d - d * d);
         let v = std::f64::consts::PI * d * d * (3.0 * r - d) / 3.0;
@@ -126,18 +126,18 @@ fn edge_impact_on_a_wall_rebounds_with_the_requested_restitution() {
             1,
         );
         world.particles.velocity[0] = Vector3::new(0.0, 0.0, -0.5);
-        let mut engine = Engine::new(5e-8);
-        engine.initialise(&mut world);
+        let (mut engine, engine_dt) = (CpuBackend::default(), 5e-8);
+        engine.initialise(&mut world, engine_dt);
         let mut touched = false;
         for _ in 0..400_000 {
-            engine.step(&mut world);
-            touched |= engine.contacts > 0;
-            if touched && engine.contacts == 0 {
+            engine.step(&mut world, engine_dt);
+            touched |= engine.stats().contacts > 0;
+            if touched && engine.stats().contacts == 0 {
                 break;
             }
         }
         let v = world.particles.velocity[0];
-        assert!(touched && engine.contacts == 0);
+        assert!(touched && engine.stats().contacts == 0);
         assert!(
             (v.z / 0.5 - e).abs() < 0.02 * e,
             "e = {e}: realised {}",
@@ -179,12 +179,12 @@ fn results_do_not_depend_on_the_number_of_threads() {
                     }
                 }
             }
-            let mut engine = Engine::new(1e-5);
-            engine.initialise(&mut world);
+            let (mut engine, engine_dt) = (CpuBackend::default(), 1e-5);
+            engine.initialise(&mut world, engine_dt);
             let mut contact_steps = 0;
             for _ in 0..4000 {
-                engine.step(&mut world);
-                contact_steps += engine.contacts;
+                engine.step(&mut world, engine_dt);
+                contact_steps += engine.stats().contacts;
             }
             assert!(
                 world
@@ -246,13 +246,13 @@ fn elastic_frictionless_collisions_conserve_energy() {
                     .map(|p| -mass * w.gravity.z * p.z)
                     .sum::<f64>()
         };
-        let mut engine = Engine::new(1e-6);
-        engine.initialise(&mut world);
+        let (mut engine, engine_dt) = (CpuBackend::default(), 1e-6);
+        engine.initialise(&mut world, engine_dt);
         let e0 = energy(&world);
         let mut touched = false;
         for _ in 0..60_000 {
-            engine.step(&mut world);
-            touched |= engine.contacts > 0;
+            engine.step(&mut world, engine_dt);
+            touched |= engine.stats().contacts > 0;
         }
         assert!(touched, "the bodies collide");
         let e1 = energy(&world);
@@ -285,12 +285,12 @@ fn damped_frictional_collision_never_gains_energy() {
             .particles
             .push(0, Point3::new(0.0003, 0.0002, 0.0165), q, 2);
         world.particles.velocity[1] = Vector3::new(0.0, 0.0, -0.5);
-        let mut engine = Engine::new(1e-6);
-        engine.initialise(&mut world);
+        let (mut engine, engine_dt) = (CpuBackend::default(), 1e-6);
+        engine.initialise(&mut world, engine_dt);
         let e0 = world.kinetic_energy();
         let mut worst: f64 = 0.0;
         for _ in 0..5_000 {
-            engine.step(&mut world);
+            engine.step(&mut world, engine_dt);
             worst = worst.max(world.kinetic_energy() / e0);
         }
         assert!(
@@ -337,10 +337,10 @@ fn a_frozen_particle_carries_a_free_one_and_never_moves() {
     p.freeze(1);
     assert_eq!(p.frozen_count(), 2);
     let frozen: Vec<_> = (0..2).map(|i| (p.position[i], p.orientation[i])).collect();
-    let mut engine = Engine::new(1e-5);
-    engine.initialise(&mut world);
+    let (mut engine, engine_dt) = (CpuBackend::default(), 1e-5);
+    engine.initialise(&mut world, engine_dt);
     for _ in 0..30_000 {
-        engine.step(&mut world);
+        engine.step(&mut world, engine_dt);
     }
     let p = &world.particles;
     for (i, pose) in frozen.iter().enumerate() {
@@ -348,7 +348,7 @@ fn a_frozen_particle_carries_a_free_one_and_never_moves() {
         assert_eq!(p.velocity[i], Vector3::zeros());
     }
     assert!(p.velocity[2].norm() < 1e-5, "{}", p.velocity[2].norm());
-    assert_eq!(engine.contacts, 1, "only the free sphere's contact");
+    assert_eq!(engine.stats().contacts, 1, "only the free sphere's contact");
     assert_eq!(world.walls[0].force, Vector3::zeros());
     // At rest: the contact carries the weight, with the overlap δ of the sphere–sphere
     // volume law at that load: small and positive, straight above the frozen one.

@@ -214,10 +214,10 @@ fn an_inlet_feeds_until_the_bed_height_is_reached() {
         sim.step();
     }
     assert!(sim.is_settled(), "not at rest at {} s", sim.time());
-    let inserted = sim.inlets[0].inserted;
-    assert_eq!(sim.inlets[0].count, inserted, "the inlet stopped");
+    let inserted = sim.inlets()[0].inserted;
+    assert_eq!(sim.inlets()[0].count, inserted, "the inlet stopped");
     assert!((50..150).contains(&inserted), "{inserted} spheres");
-    let (height, porosity) = bed_figures(&sim.world, &bed).unwrap();
+    let (height, porosity) = bed_figures(&sim.world(), &bed).unwrap();
     println!("{inserted} spheres, bed height {height:.4} m, porosity {porosity:.3}");
     assert!(
         height > target - 0.5 * d && height < target + 2.0 * d,
@@ -261,7 +261,7 @@ fn fill_from_above(freeze: bool) -> (talus::scene::Simulation, Vec<Option<Pose>>
     let mut frozen_at = Vec::new();
     while !sim.is_settled() && sim.time() < 3.0 {
         sim.step();
-        let p = &sim.world.particles;
+        let p = &sim.world().particles;
         frozen_at.resize(p.len(), None);
         for (i, at) in frozen_at.iter_mut().enumerate() {
             if p.frozen[i] && at.is_none() {
@@ -300,10 +300,10 @@ fn scene_fed_from_above(freeze: bool) -> talus::scene::Scene {
 /// restores both: stepping on from the restored state gives the same bits.
 #[test]
 fn frozen_particles_and_the_raised_box_survive_a_saved_state() {
-    use talus::scene::state::{StateReader, StateWriter};
+    use talus::scene::{StateReader, StateWriter};
     let scene = scene_fed_from_above(true);
     let mut sim = talus::scene::Simulation::new(&scene);
-    while sim.world.particles.frozen_count() < 20 {
+    while sim.world().particles.frozen_count() < 20 {
         sim.step();
         assert!(sim.time() < 1.0, "nothing froze");
     }
@@ -314,21 +314,21 @@ fn frozen_particles_and_the_raised_box_survive_a_saved_state() {
         for _ in 0..3000 {
             sim.step();
         }
-        let p = &sim.world.particles;
+        let p = &sim.world().particles;
         let bits: Vec<u64> = p
             .position
             .iter()
             .flat_map(|x| x.iter().map(|c| c.to_bits()).collect::<Vec<_>>())
             .collect();
-        (bits, p.frozen.clone(), sim.inlets[0].offset)
+        (bits, p.frozen.clone(), sim.inlets()[0].offset)
     };
     let first = run_on(&mut sim);
     let mut restored = talus::scene::Simulation::new(&scene);
     let mut reader = StateReader::new(&bytes);
     restored.read_state(7, &mut reader).unwrap();
     assert!(reader.is_done());
-    assert!(restored.world.particles.frozen_count() >= 20);
-    assert!(restored.inlets[0].offset.z > 0.0);
+    assert!(restored.world().particles.frozen_count() >= 20);
+    assert!(restored.inlets()[0].offset.z > 0.0);
     assert_eq!(run_on(&mut restored), first);
 }
 
@@ -345,9 +345,9 @@ fn a_bed_fed_from_above_with_its_buried_part_frozen() {
     let mut figures = Vec::new();
     for freeze in [true, false] {
         let (sim, frozen_at, bed) = fill_from_above(freeze);
-        let inlet = &sim.inlets[0];
-        let (height, porosity) = bed_figures(&sim.world, &bed).unwrap();
-        let p = &sim.world.particles;
+        let inlet = &sim.inlets()[0];
+        let (height, porosity) = bed_figures(&sim.world(), &bed).unwrap();
+        let p = &sim.world().particles;
         let frozen = p.frozen_count();
         println!(
             "freeze {freeze}: {} spheres, {frozen} frozen, bed height {height:.4} m, \

@@ -29,14 +29,14 @@ fn two_hundred_pellets_at_n_4_5_settle_into_a_wall_ordered_bed() {
     while !sim.is_settled() && sim.time() < 1.5 {
         sim.step();
     }
-    let p = &sim.world.particles;
+    let p = &sim.world().particles;
     println!(
         "{} pellets: settled = {} at {:.3} s after {} steps of {:.2e} s, largest speed {:.1e} m/s",
         p.len(),
         sim.is_settled(),
         sim.time(),
         sim.steps,
-        sim.engine.dt,
+        sim.dt(),
         sim.max_speed()
     );
     assert!(sim.is_settled(), "not at rest by {} s", sim.time());
@@ -46,7 +46,7 @@ fn two_hundred_pellets_at_n_4_5_settle_into_a_wall_ordered_bed() {
         assert!(x.x.hypot(x.y) < 0.0125 && x.z > 0.0, "{x}");
     }
 
-    let packing = analyse(&sim.world, scene.bed.as_ref().unwrap()).unwrap();
+    let packing = analyse(&sim.world(), scene.bed.as_ref().unwrap()).unwrap();
     let d = 5.5e-3;
     let radial = &packing.radial;
     let profile: Vec<(f64, f64)> = radial

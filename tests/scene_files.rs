@@ -230,7 +230,7 @@ fn prescribed_wall_motion() {
     let mut sim =
         wall_scene("{ kind = \"rotation\", axis = [0, 0, 1], point = [0.1, 0, 0], rpm = 30 }");
     let start: Vec<Point3<f64>> = (0..12)
-        .map(|f| sim.world.walls[0].facet_world(f)[0])
+        .map(|f| sim.world().walls[0].facet_world(f)[0])
         .collect();
     for _ in 0..50_000 {
         sim.step();
@@ -239,10 +239,10 @@ fn prescribed_wall_motion() {
     let pivot = Point3::new(0.1, 0.0, 0.0);
     for (f, x0) in start.iter().enumerate() {
         let expected = pivot + turn * (x0 - pivot);
-        let got = sim.world.walls[0].facet_world(f)[0];
+        let got = sim.world().walls[0].facet_world(f)[0];
         assert!((got - expected).norm() < 1e-9, "{got} vs {expected}");
     }
-    assert_eq!(sim.world.walls[0].reference(), pivot);
+    assert_eq!(sim.world().walls[0].reference(), pivot);
     // Oscillation: back where it started after whole periods, displaced by the
     // amplitude after a quarter period.
     let mut sim =
@@ -250,12 +250,12 @@ fn prescribed_wall_motion() {
     for _ in 0..1000 {
         sim.step();
     }
-    let z = sim.world.walls[0].pose.translation.vector.z;
+    let z = sim.world().walls[0].pose.translation.vector.z;
     assert!((z - 0.002).abs() < 1e-8, "quarter period: {z}");
     for _ in 0..3000 {
         sim.step();
     }
-    let z = sim.world.walls[0].pose.translation.vector.z;
+    let z = sim.world().walls[0].pose.translation.vector.z;
     assert!(z.abs() < 1e-8, "one period: {z}");
     // A table: linear ramp of the velocity from 0 to 1 m/s over 0.01 s, then held:
     // displacement 0.005 m at 0.01 s and 0.015 m at 0.02 s.
@@ -265,14 +265,14 @@ fn prescribed_wall_motion() {
     for _ in 0..1000 {
         sim.step();
     }
-    let x = sim.world.walls[0].pose.translation.vector.x;
+    let x = sim.world().walls[0].pose.translation.vector.x;
     assert!((x - 0.005).abs() < 1e-8, "ramp: {x}");
     for _ in 0..1000 {
         sim.step();
     }
-    let x = sim.world.walls[0].pose.translation.vector.x;
+    let x = sim.world().walls[0].pose.translation.vector.x;
     assert!((x - 0.015).abs() < 1e-8, "held: {x}");
-    assert!((sim.world.walls[0].velocity.x - 1.0).abs() < 1e-12);
+    assert!((sim.world().walls[0].velocity.x - 1.0).abs() < 1e-12);
 }
 
 #[test]
@@ -282,28 +282,32 @@ fn inlets_insert_at_their_rate_without_overlap() {
     );
     let scene = Scene::parse(&text, Path::new("s.toml")).unwrap();
     let mut sim = Simulation::new(&scene);
-    assert_eq!(sim.world.particles.len(), 1, "one particle is due at t = 0");
+    assert_eq!(
+        sim.world().particles.len(),
+        1,
+        "one particle is due at t = 0"
+    );
     for _ in 0..100 {
         sim.step();
     }
     // 20000/s over 1 ms: 20 or 21 due (one at t = 0; the step count lands on 1 ms
     // within round-off); all fit easily.
-    let n = sim.world.particles.len();
+    let n = sim.world().particles.len();
     assert!(n == 20 || n == 21, "{n}");
     for _ in 0..200 {
         sim.step();
     }
-    assert_eq!(sim.world.particles.len(), 40);
+    assert_eq!(sim.world().particles.len(), 40);
     assert!(sim.inlets_done());
     // At insertion every bounding sphere was inside the box and clear of the others:
     // check on a fresh scene right after each insertion.
     let mut sim = Simulation::new(&scene);
     let r = 0.005 * 3f64.sqrt();
     let mut checked = 0;
-    let mut n = sim.world.particles.len();
+    let mut n = sim.world().particles.len();
     while !sim.inlets_done() {
         sim.step();
-        let p = &sim.world.particles;
+        let p = &sim.world().particles;
         for i in n..p.len() {
             let x = p.position[i];
             assert!(

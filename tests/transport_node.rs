@@ -93,5 +93,5 @@ async fn a_client_steps_the_served_drum() {
     assert!(bad.error.contains("malformed"), "{}", bad.error);
     session.close().await.unwrap();
     let service = node.stop();
-    assert_eq!(service.component().simulation().unwrap().world.time, 0.02);
+    assert_eq!(service.component().simulation().unwrap().world().time, 0.02);
 }

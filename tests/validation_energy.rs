@@ -53,15 +53,16 @@ fn elastic_gas_of_dodecahedra_conserves_energy() {
     let scene = Scene::parse(SCENE, Path::new("gas.toml")).unwrap();
     let mut sim = Simulation::new(&scene);
     let mut rng = Pcg64::seed_from_u64(3);
-    let p = &mut sim.world.particles;
-    assert_eq!(p.len(), 100);
-    for i in 0..p.len() {
-        let mut v = || rng.random_range(-1.0..1.0);
-        p.velocity[i] = Vector3::new(v(), v(), v()) * 2.0;
-        p.angular_momentum[i] = Vector3::new(v(), v(), v()) * 1e-7;
-    }
-    sim.engine.initialise(&mut sim.world);
-    let energy = |s: &Simulation| s.world.kinetic_energy() + s.engine.elastic_energy;
+    assert_eq!(sim.world().particles.len(), 100);
+    sim.edit_world(|w| {
+        let p = &mut w.particles;
+        for i in 0..p.len() {
+            let mut v = || rng.random_range(-1.0..1.0);
+            p.velocity[i] = Vector3::new(v(), v(), v()) * 2.0;
+            p.angular_momentum[i] = Vector3::new(v(), v(), v()) * 1e-7;
+        }
+    });
+    let energy = |s: &Simulation| s.world().kinetic_energy() + s.stats().elastic_energy;
     let e0 = energy(&sim);
     // Count contacts that begin: pairs in contact now but not at the previous check.
     let mut collisions = 0usize;
@@ -90,7 +91,7 @@ fn elastic_gas_of_dodecahedra_conserves_energy() {
 /// Pairs of particles whose bounding spheres overlap and whose shapes intersect.
 fn touching(sim: &Simulation) -> BTreeSet<(usize, usize)> {
     use talus::geometry::gjk::{GjkResult, gjk};
-    let w = &sim.world;
+    let w = &sim.world();
     let p = &w.particles;
     let shape = w.body_types[0].shape.as_polyhedron().unwrap();
     let r = shape.circumradius();

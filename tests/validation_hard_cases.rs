@@ -75,16 +75,16 @@ bodies = [{{ position = [0.0, 0.0, 0.0065], rotation = [0.3, 0.2, 0.1], velocity
     let mut lowest: f64 = 1.0;
     while !sim.is_finished() {
         sim.step();
-        lowest = lowest.min(sim.world.particles.position[0].z);
+        lowest = lowest.min(sim.world().particles.position[0].z);
     }
-    let v = sim.world.particles.velocity[0];
+    let v = sim.world().particles.velocity[0];
     println!(
         "dt = {:.3e} s: lowest centroid {:.3} mm, rebound velocity {v}",
         scene.dt,
         lowest * 1e3
     );
     assert!(v.z > 0.0, "did not bounce: {v}");
-    assert!(sim.world.particles.position[0].z > 0.0);
+    assert!(sim.world().particles.position[0].z > 0.0);
     // The centroid never came within half an inscribed radius of the plate.
     assert!(lowest > 0.002, "lowest centroid {lowest}");
 }
@@ -139,7 +139,7 @@ count = 150
 "#
     );
     let sim = settle(&text, [0.0; 3], [0.05, 0.05, 0.2], 3.0, true);
-    let w = &sim.world;
+    let w = &sim.world();
     let p = &w.particles;
     let large = w.body_types[p.body_type[0] as usize]
         .shape
@@ -206,10 +206,10 @@ bodies = [{{ position = [0.0, 0.0, 0.0055], rotation = [0.3, 0.5, 0.1] }}]
         while !sim.is_finished() {
             sim.step();
         }
-        let ke = sim.world.kinetic_energy();
-        let weight = sim.world.body_types[0].mass * 9.81;
+        let ke = sim.world().kinetic_energy();
+        let weight = sim.world().body_types[0].mass * 9.81;
         println!("friction {friction}: kinetic energy after 0.3 s {ke:.2e} J");
         assert!(ke < 1e-12, "friction {friction}: still moving, {ke} J");
-        assert!((sim.world.walls[0].force.z / -weight - 1.0).abs() < 1e-3);
+        assert!((sim.world().walls[0].force.z / -weight - 1.0).abs() < 1e-3);
     }
 }

@@ -19,7 +19,7 @@
 
 use nalgebra::{Matrix3, Point3, UnitQuaternion, Vector3};
 use talus::contact::Material;
-use talus::engine::step::Engine;
+use talus::engine::{Backend, CpuBackend};
 use talus::geometry::surfaces;
 use talus::geometry::{Shape, generators};
 use talus::world::{BodyType, Wall, World};
@@ -95,13 +95,13 @@ fn impact(theta_deg: f64, dt: f64) -> Outcome {
     let v_ref = Vector3::new(0.0, 0.0, -SPEED) + n * (j / m);
     let w_ref = i_inv * lowest.cross(&(n * j));
 
-    let mut engine = Engine::new(dt);
-    engine.initialise(&mut world);
+    let (mut engine, engine_dt) = (CpuBackend::default(), dt);
+    engine.initialise(&mut world, engine_dt);
     let mut touched = false;
     let mut deepest = 0.0f64;
     let mut below_max = 0;
     for _ in 0..200_000 {
-        engine.step(&mut world);
+        engine.step(&mut world, engine_dt);
         let qq = world.particles.orientation[0];
         let x = world.particles.position[0];
         let zs: Vec<f64> = p
@@ -111,8 +111,8 @@ fn impact(theta_deg: f64, dt: f64) -> Outcome {
             .collect();
         deepest = deepest.max(-zs.iter().cloned().fold(f64::INFINITY, f64::min));
         below_max = below_max.max(zs.iter().filter(|z| **z < 0.0).count());
-        touched |= engine.contacts > 0;
-        if touched && engine.contacts == 0 {
+        touched |= engine.stats().contacts > 0;
+        if touched && engine.stats().contacts == 0 {
             break;
         }
     }

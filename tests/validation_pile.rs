@@ -64,13 +64,13 @@ spacing = 0.0106
 count = 1000
 "#;
     let energy = |sim: &Simulation| {
-        let w = &sim.world;
+        let w = &sim.world();
         let p = &w.particles;
         let potential: f64 = (0..p.len())
             .map(|i| w.body_types[p.body_type[i] as usize].mass * 9.81 * p.position[i].z)
             .sum();
         (
-            w.kinetic_energy() + potential + sim.engine.elastic_energy,
+            w.kinetic_energy() + potential + sim.stats().elastic_energy,
             potential,
         )
     };
@@ -78,10 +78,10 @@ count = 1000
         &Scene::parse(text, Path::new("pile.toml")).unwrap(),
     ));
     let sim = settle(text, [0.0; 3], [0.15, 0.15, 0.3], 3.0, true);
-    assert_eq!(sim.world.particles.len(), 1000);
+    assert_eq!(sim.world().particles.len(), 1000);
     let end = energy(&sim);
     let released = start.1 - end.1;
-    let ke = sim.world.kinetic_energy();
+    let ke = sim.world().kinetic_energy();
     println!(
         "energy: start {:.4e} J, end {:.4e} J; potential released {released:.3e} J, \
          kinetic left {ke:.3e} J",

@@ -59,13 +59,13 @@ fn realised(e: f64, tilt: [f64; 3], regularisation: f64, dt_factor: f64) -> f64 
     let mut touched = false;
     for _ in 0..2_000_000 {
         sim.step();
-        touched |= sim.engine.contacts > 0;
-        if touched && sim.engine.contacts == 0 {
+        touched |= sim.stats().contacts > 0;
+        if touched && sim.stats().contacts == 0 {
             break;
         }
     }
     assert!(touched);
-    sim.world.particles.velocity[0].z / 1.0
+    sim.world().particles.velocity[0].z / 1.0
 }
 
 #[test]

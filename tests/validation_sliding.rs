@@ -15,7 +15,7 @@ use nalgebra::{Point3, UnitQuaternion, Vector3};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 use talus::contact::Material;
-use talus::engine::step::Engine;
+use talus::engine::{Backend, CpuBackend};
 use talus::geometry::{Shape, generators};
 use talus::world::{BodyType, Wall, World};
 
@@ -94,11 +94,11 @@ fn sweep(lambda: f64) -> Vec<Vector3<f64>> {
     world
         .particles
         .push(0, Point3::new(-0.03, 0.011, -lowest - 1e-3), q, 1);
-    let mut engine = Engine::new(1e-5);
+    let (mut engine, engine_dt) = (CpuBackend::default(), 1e-5);
     (0..=600)
         .map(|k| {
             world.particles.position[0].x = -0.03 + 1e-4 * k as f64;
-            engine.initialise(&mut world);
+            engine.initialise(&mut world, engine_dt);
             world.particles.force[0]
         })
         .collect()

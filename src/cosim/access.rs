@@ -97,10 +97,10 @@ impl Component {
         let drive = |w: usize| &self.drives[w];
         let sim = self.sim.as_ref();
         match role {
-            Role::Time => sim.map_or(0.0, |s| s.world.time),
+            Role::Time => sim.map_or(0.0, |s| s.world().time),
             Role::TimeStep => self.params.dt,
-            Role::KineticEnergy => sim.map_or(0.0, |s| s.world.kinetic_energy()),
-            Role::MaxSpeed => sim.map_or(0.0, |s| s.world.max_speed()),
+            Role::KineticEnergy => sim.map_or(0.0, |s| s.world().kinetic_energy()),
+            Role::MaxSpeed => sim.map_or(0.0, |s| s.world().max_speed()),
             Role::WallVelocity(w) => match drive(w) {
                 WallDrive::Velocity { linear, .. } => linear[k],
                 _ => 0.0,
@@ -120,23 +120,23 @@ impl Component {
             Role::WallForce(w) => self.means[w].force[k],
             Role::WallTorque(w) => self.means[w].torque[k],
             Role::WallPower(w) => self.means[w].power,
-            Role::WallForceEnd(w) => sim.map_or(0.0, |s| s.world.walls[w].force[k]),
-            Role::WallTorqueEnd(w) => sim.map_or(0.0, |s| s.world.walls[w].torque[k]),
+            Role::WallForceEnd(w) => sim.map_or(0.0, |s| s.world().walls[w].force[k]),
+            Role::WallTorqueEnd(w) => sim.map_or(0.0, |s| s.world().walls[w].torque[k]),
             Role::WallVertices(w) => {
-                let wall = sim.map_or(&self.scene.world.walls[w], |s| &s.world.walls[w]);
+                let wall = sim.map_or(&self.scene.world.walls[w], |s| &s.world().walls[w]);
                 (wall.pose * wall.vertices[k / 3])[k % 3]
             }
             Role::WallFacetForces(w) => {
-                sim.map_or(0.0, |s| s.world.walls[w].facet_force[k / 3][k % 3])
+                sim.map_or(0.0, |s| s.world().walls[w].facet_force[k / 3][k % 3])
             }
             Role::DriveTorque => self.drum_means().0,
             Role::DrivePower => self.drum_means().1,
             Role::AngleOfRepose => match (sim, &self.scene.drum) {
-                (Some(s), Some(d)) => d.surface(&s.world).map_or(0.0, |f| f.slope.atan().abs()),
+                (Some(s), Some(d)) => d.surface(&s.world()).map_or(0.0, |f| f.slope.atan().abs()),
                 _ => 0.0,
             },
             Role::BedHeight | Role::BedPorosity => match (sim, &self.scene.bed) {
-                (Some(s), Some(bed)) => crate::analysis::packing::bed_figures(&s.world, bed)
+                (Some(s), Some(bed)) => crate::analysis::packing::bed_figures(&s.world(), bed)
                     .map_or(0.0, |(h, e)| if role == Role::BedHeight { h } else { e }),
                 _ => 0.0,
             },
@@ -157,7 +157,7 @@ impl Component {
         let mut power = 0.0;
         for &w in &drum.walls {
             let m = &self.means[w];
-            torque -= drum.axial_torque(&sim.world, w, &m.force, &m.torque);
+            torque -= drum.axial_torque(&sim.world(), w, &m.force, &m.torque);
             power += m.power;
         }
         (torque, power)
@@ -190,7 +190,7 @@ impl Component {
                 Role::TimeStep => {
                     self.params.dt = *x;
                     if let Some(sim) = &mut self.sim {
-                        sim.engine.dt = *x;
+                        sim.set_time_step(*x);
                     }
                 }
                 Role::WallVelocity(w) => {
@@ -239,8 +239,8 @@ impl Component {
             let sim = self.sim.as_ref();
             *o = match v.role {
                 Role::Threads => self.params.threads as i64,
-                Role::Particles => sim.map_or(0, |s| s.world.particles.len() as i64),
-                Role::Contacts => sim.map_or(0, |s| s.engine.contacts as i64),
+                Role::Particles => sim.map_or(0, |s| s.world().particles.len() as i64),
+                Role::Contacts => sim.map_or(0, |s| s.stats().contacts as i64),
                 _ => unreachable!("not an integer variable"),
             };
         }

@@ -1,6 +1,7 @@
 //! The component: life cycle and communication steps.
 
 use std::fmt;
+use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 
 use nalgebra::{Point3, Quaternion, UnitQuaternion, Vector3};
@@ -10,7 +11,7 @@ use super::pool::JoinedPool;
 use super::variables::{Variable, variable_table};
 use crate::Real;
 use crate::output::RunOutput;
-use crate::scene::{Scene, Simulation};
+use crate::scene::{Scene, SimState, Simulation};
 use crate::world::{DriveInput, WallMotion};
 
 /// Mode of the life cycle.
@@ -87,7 +88,7 @@ pub struct WallMeans {
 #[derive(Clone, Debug)]
 pub struct ComponentState {
     pub(super) mode: Mode,
-    pub(super) sim: Simulation,
+    pub(super) sim: SimState,
     pub(super) drives: Vec<WallDrive>,
     pub(super) means: Vec<WallMeans>,
 }
@@ -131,7 +132,7 @@ impl fmt::Debug for Component {
         f.debug_struct("Component")
             .field("scene", &self.scene.file)
             .field("mode", &self.mode)
-            .field("time", &self.sim.as_ref().map(|s| s.world.time))
+            .field("time", &self.sim.as_ref().map(|s| s.world().time))
             .finish()
     }
 }
@@ -252,8 +253,8 @@ impl Component {
         let pool =
             JoinedPool::new(self.params.threads).map_err(|e| CosimError::Threads(e.to_string()))?;
         let mut sim = pool.install(|| Simulation::new(&self.scene));
-        sim.engine.dt = self.params.dt;
-        sim.world.time = start_time;
+        sim.set_time_step(self.params.dt);
+        sim.set_time(start_time);
         self.pool = Some(pool);
         self.sim = Some(sim);
         self.means = vec![WallMeans::default(); self.drives.len()];
@@ -275,7 +276,7 @@ impl Component {
             let out = &self.scene.spec.output;
             Some(RunOutput::create(
                 &self.base_dir.join(&self.params.output_dir),
-                &sim.world,
+                sim.world(),
                 out.frame_interval,
                 out.csv_interval,
                 self.scene.drum.as_ref(),
@@ -287,25 +288,26 @@ impl Component {
             .as_mut()
             .expect("a running component has a simulation");
         let pool = self.pool.as_ref().expect("a running component has a pool");
-        for (w, drive) in self.drives.iter().enumerate() {
-            let wall = &mut sim.world.walls[w];
-            match drive {
-                WallDrive::Prescribed => {}
-                WallDrive::Velocity { linear, angular } => {
-                    wall.velocity = *linear;
-                    wall.angular_velocity = *angular;
-                }
-                WallDrive::Pose {
-                    position,
-                    orientation,
-                } => {
-                    wall.pose.translation.vector = *position;
-                    wall.pose.rotation = unit_quaternion(orientation);
+        let drives = &self.drives;
+        sim.move_walls(|walls| {
+            for (wall, drive) in walls.iter_mut().zip(drives) {
+                match drive {
+                    WallDrive::Prescribed => {}
+                    WallDrive::Velocity { linear, angular } => {
+                        wall.velocity = *linear;
+                        wall.angular_velocity = *angular;
+                    }
+                    WallDrive::Pose {
+                        position,
+                        orientation,
+                    } => {
+                        wall.pose.translation.vector = *position;
+                        wall.pose.rotation = unit_quaternion(orientation);
+                    }
                 }
             }
-        }
-        sim.world.follow_leaders();
-        pool.install(|| sim.engine.initialise(&mut sim.world));
+        });
+        pool.install(|| sim.initialise());
         self.means = instantaneous_means(sim);
         self.output = output;
         self.mode = Mode::Step;
@@ -335,7 +337,7 @@ impl Component {
                 "step size {h} must be positive and finite"
             )));
         }
-        let now = self.sim.as_ref().expect("step mode").world.time;
+        let now = self.sim.as_ref().expect("step mode").time();
         if !t.is_finite() || (t - now).abs() > 1e-9 * now.abs().max(h) {
             return Err(CosimError::BadStep(format!(
                 "the step starts at {t} but the component is at time {now}"
@@ -348,40 +350,36 @@ impl Component {
             .as_mut()
             .expect("a running component has a simulation");
         let pool = self.pool.as_ref().expect("a running component has a pool");
-        let before = sim.clone();
+        // Rollback through the saved state, not a copy of the whole simulation.
+        let before = sim.snapshot();
         let end = t + h;
-        let dt = sim.engine.dt;
-        let walls = sim.world.walls.len();
-        let mut impulse = vec![WallMeans::default(); walls];
+        let mut impulse = vec![WallMeans::default(); drives.len()];
         let mut targets = Vec::new();
-        for (w, drive) in drives.iter().enumerate() {
-            let wall = &mut sim.world.walls[w];
-            match drive {
-                WallDrive::Prescribed => {}
-                WallDrive::Velocity { linear, angular } => {
-                    wall.velocity = *linear;
-                    wall.angular_velocity = *angular;
-                }
-                WallDrive::Pose {
-                    position,
-                    orientation,
-                } => {
-                    let q = unit_quaternion(orientation);
-                    wall.velocity = (position - wall.pose.translation.vector) / h;
-                    wall.angular_velocity = (q * wall.pose.rotation.inverse()).scaled_axis() / h;
-                    targets.push((w, *position, q));
+        sim.move_walls(|walls| {
+            for (w, (wall, drive)) in walls.iter_mut().zip(&drives).enumerate() {
+                match drive {
+                    WallDrive::Prescribed => {}
+                    WallDrive::Velocity { linear, angular } => {
+                        wall.velocity = *linear;
+                        wall.angular_velocity = *angular;
+                    }
+                    WallDrive::Pose {
+                        position,
+                        orientation,
+                    } => {
+                        let q = unit_quaternion(orientation);
+                        wall.velocity = (position - wall.pose.translation.vector) / h;
+                        wall.angular_velocity =
+                            (q * wall.pose.rotation.inverse()).scaled_axis() / h;
+                        targets.push((w, *position, q));
+                    }
                 }
             }
-        }
-        sim.world.follow_leaders();
+        });
         let mut output = self.output.take();
         let result = pool.install(|| -> std::io::Result<()> {
             let mut last = instantaneous_means(sim);
-            while sim.world.time < end {
-                let left = end - sim.world.time;
-                let sub = if left <= dt * (1.0 + 1e-6) { left } else { dt };
-                sim.engine.dt = sub;
-                sim.step();
+            let advanced = sim.advance_to(end, |sim, sub| {
                 let now = instantaneous_means(sim);
                 for ((acc, a), b) in impulse.iter_mut().zip(&last).zip(&now) {
                     acc.force += (a.force + b.force) * (0.5 * sub);
@@ -389,26 +387,30 @@ impl Component {
                     acc.power += (a.power + b.power) * (0.5 * sub);
                 }
                 last = now;
-                if let Some(out) = &mut output {
-                    out.record(&sim.world, sub, sim.engine.contacts, false)?;
+                match &mut output {
+                    Some(out) => match out.record(sim.world(), sub, sim.stats().contacts, false) {
+                        Ok(()) => ControlFlow::Continue(()),
+                        Err(e) => ControlFlow::Break(e),
+                    },
+                    None => ControlFlow::Continue(()),
                 }
-                if sub == left {
-                    break;
-                }
+            });
+            match advanced {
+                ControlFlow::Continue(()) => Ok(()),
+                ControlFlow::Break(e) => Err(e),
             }
-            Ok(())
         });
-        sim.engine.dt = dt;
-        sim.world.time = end;
-        for (w, position, q) in targets {
-            let wall = &mut sim.world.walls[w];
-            wall.pose.translation.vector = position;
-            wall.pose.rotation = q;
-        }
-        sim.world.follow_leaders();
+        sim.set_time(end);
+        sim.move_walls(|walls| {
+            for (w, position, q) in targets {
+                walls[w].pose.translation.vector = position;
+                walls[w].pose.rotation = q;
+            }
+        });
         self.output = output;
         if let Some(problem) = divergence(sim) {
-            *sim = before;
+            sim.restore(&before)
+                .expect("a snapshot of this simulation restores");
             return Err(CosimError::Diverged(problem));
         }
         result?;
@@ -431,8 +433,8 @@ impl Component {
             "initialisation, step",
         )?;
         if let (Some(out), Some(sim)) = (&mut self.output, &self.sim) {
-            out.record(&sim.world, 0.0, sim.engine.contacts, true)?;
-            out.finish(&sim.world)?;
+            out.record(sim.world(), 0.0, sim.stats().contacts, true)?;
+            out.finish(&sim.world())?;
         }
         self.output = None;
         self.mode = Mode::Terminated;
@@ -461,7 +463,7 @@ impl Component {
         let wall = self
             .sim
             .as_ref()
-            .map_or(self.scene.world.walls.get(w), |s| s.world.walls.get(w))?;
+            .map_or(self.scene.world.walls.get(w), |s| s.world().walls.get(w))?;
         Some(WallMesh {
             vertices: wall.vertices.iter().map(|v| wall.pose * v).collect(),
             triangles: &wall.triangles,
@@ -511,7 +513,7 @@ fn unit_quaternion(q: &[Real; 4]) -> UnitQuaternion<Real> {
 }
 
 fn instantaneous_means(sim: &Simulation) -> Vec<WallMeans> {
-    sim.world
+    sim.world()
         .walls
         .iter()
         .map(|w| WallMeans {
@@ -524,7 +526,7 @@ fn instantaneous_means(sim: &Simulation) -> Vec<WallMeans> {
 
 /// What is not finite in the state, if anything.
 fn divergence(sim: &Simulation) -> Option<String> {
-    let p = &sim.world.particles;
+    let p = &sim.world().particles;
     for i in 0..p.len() {
         if !(p.position[i].coords.iter().all(|x| x.is_finite())
             && p.velocity[i].iter().all(|x| x.is_finite())

@@ -4,7 +4,7 @@
 
 use super::CosimError;
 use super::component::{Component, ComponentState, Mode, RUNNING, WallDrive, WallMeans};
-use crate::scene::{StateError, StateReader, StateWriter};
+use crate::scene::{SimState, StateError, StateReader, StateWriter};
 
 impl Component {
     /// The state as it is now (initialisation, step or terminated mode).
@@ -16,7 +16,7 @@ impl Component {
         )?;
         Ok(ComponentState {
             mode: self.mode,
-            sim: self.sim.clone().expect("running"),
+            sim: self.sim.as_ref().expect("running").snapshot(),
             drives: self.drives.clone(),
             means: self.means.clone(),
         })
@@ -34,8 +34,8 @@ impl Component {
                 "a state of another scene".into(),
             )));
         }
+        self.sim.as_mut().expect("running").restore(&state.sim)?;
         self.mode = state.mode;
-        self.sim = Some(state.sim.clone());
         self.drives = state.drives.clone();
         self.means = state.means.clone();
         Ok(())
@@ -44,7 +44,7 @@ impl Component {
     /// A saved state as bytes.
     pub fn state_to_bytes(&self, state: &ComponentState) -> Vec<u8> {
         let mut w = StateWriter::default();
-        state.sim.write_state(self.fingerprint, &mut w);
+        state.sim.write(self.fingerprint, &mut w);
         w.u64(match state.mode {
             Mode::Initialisation => 1,
             Mode::Step => 2,
@@ -82,9 +82,9 @@ impl Component {
             &[Mode::Initialisation, Mode::Step, Mode::Terminated],
             RUNNING,
         )?;
-        let mut sim = self.sim.clone().expect("running");
         let mut r = StateReader::new(bytes);
-        sim.read_state(self.fingerprint, &mut r)?;
+        let sim = SimState::read(self.fingerprint, &mut r)?;
+        self.sim.as_ref().expect("running").check_state(&sim)?;
         let corrupt = |m: &str| CosimError::State(StateError::Corrupt(m.into()));
         let mode = match r.u64()? {
             1 => Mode::Initialisation,

@@ -22,6 +22,7 @@
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 
 use crate::Real;
+use crate::geometry::is_isotropic;
 
 /// The rotational state of one rigid body.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -67,13 +68,6 @@ pub fn rotate(
 #[inline]
 pub fn half_kick(state: &mut RotationState, torque: &Vector3<Real>, dt: Real) {
     state.angular_momentum += torque * (0.5 * dt);
-}
-
-/// Whether principal moments are equal to round-off: such a body (a sphere, a cube, a
-/// regular polyhedron) turns steadily about its angular momentum.
-#[inline]
-pub fn is_isotropic(inertia: &Vector3<Real>) -> bool {
-    inertia.max() - inertia.min() <= 1e-12 * inertia.max()
 }
 
 /// Torque-free rotation over `dt` (see the module docs).

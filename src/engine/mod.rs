@@ -1,17 +1,28 @@
-//! One time step of the DEM: broad phase, narrow phase, forces, integration.
+//! The DEM step and the seam to what computes it.
 //!
-//! The rigid-body integrator ([`integrate`]), the broad phase ([`broad_phase`]), the
-//! Verlet lists built from it ([`neighbours`]), the contact parameters of every pair of
-//! body types (`laws`), one CPU time step ([`step`], rayon) and the suggested time
-//! step ([`time_step`]). Every phase is written the way a GPU
+//! [`Backend`] is the interface a driver steps through, with its sync contract (see
+//! [`backend`]); [`CpuBackend`] (module [`cpu`], rayon) is its reference
+//! implementation. Beside them: the step parameters ([`params`]), what a step hands
+//! back ([`stats`]: counts, energies, time per stage), the rigid-body integrator
+//! ([`integrate`]), the broad phase ([`broad_phase`]), the Verlet lists built from it
+//! ([`neighbours`]), the contact parameters of every pair of body types (`laws`) and
+//! the suggested time step ([`time_step`]). Every stage is written the way a GPU
 //! kernel is: a data-parallel loop over particles or candidate pairs reading flat
 //! arrays and writing its own slot; each particle then gathers its pairs' forces in
 //! pair order, so results do not depend on the number of threads.
 
+pub mod backend;
 pub mod broad_phase;
+pub mod cpu;
 mod fast_hash;
 pub mod integrate;
 mod laws;
 pub mod neighbours;
-pub mod step;
+pub mod params;
+pub mod stats;
 pub mod time_step;
+
+pub use backend::{Backend, ContactHistory, WallKey};
+pub use cpu::CpuBackend;
+pub use params::{REGULARISATION_LENGTH, StepParams};
+pub use stats::{Stage, StageTimes, StepStats};

@@ -197,8 +197,7 @@ pub unsafe extern "C" fn talus_time(handle: *mut TalusComponent, time: *mut f64)
             .component
             .simulation()
             .ok_or("the component is not initialised")?
-            .world
-            .time;
+            .time();
         unsafe { put(time, t, "time") }
     })
 }

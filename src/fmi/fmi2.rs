@@ -495,7 +495,7 @@ pub unsafe extern "C" fn fmi2GetRealStatus(c: Component, kind: c_int, value: *mu
         let t = inst
             .component
             .simulation()
-            .map_or(inst.start_time, |s| s.world.time);
+            .map_or(inst.start_time, |s| s.world().time);
         unsafe { put(value, t, "value") }?;
         Ok(OK)
     })

@@ -477,7 +477,7 @@ pub unsafe extern "C" fn fmi3DoStep(
         let t = inst
             .component
             .simulation()
-            .map_or(current_communication_point, |s| s.world.time);
+            .map_or(current_communication_point, |s| s.world().time);
         for (p, what) in [
             (event_handling_needed, "eventHandlingNeeded"),
             (terminate_simulation, "terminateSimulation"),

@@ -59,3 +59,10 @@ impl MassProperties {
         }
     }
 }
+
+/// Whether principal moments `inertia` are equal to round-off (a sphere, a cube, a
+/// Platonic solid): then the angular velocity is the angular momentum over any one of
+/// them, in every frame.
+pub fn is_isotropic(inertia: &nalgebra::Vector3<crate::Real>) -> bool {
+    inertia.max() - inertia.min() <= 1e-12 * inertia.max()
+}

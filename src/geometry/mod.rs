@@ -36,7 +36,7 @@ pub mod wall;
 
 pub use error::GeometryError;
 pub use hull::convex_hull;
-pub use mass::MassProperties;
+pub use mass::{MassProperties, is_isotropic};
 pub use plane::Plane;
 pub use polyhedron::ConvexPolyhedron;
 pub use shape::{Shape, Sphere};

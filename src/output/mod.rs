@@ -26,9 +26,36 @@ use serde::Serialize;
 
 use crate::Real;
 use crate::analysis::{Drum, DrumSummary};
+use crate::engine::{Stage, StageTimes};
 use crate::world::World;
 use drum::DrumOutput;
 use vtk::Collection;
+
+/// Time spent in one stage of the steps of a run.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct StageSummary {
+    /// The stage (see [`crate::engine::Stage`]).
+    pub stage: String,
+    /// Wall-clock seconds, summed over the run.
+    pub seconds: Real,
+    /// Share of the time of all stages.
+    pub share: Real,
+}
+
+impl StageSummary {
+    /// The stages of `times`, in step order.
+    pub fn of(times: &StageTimes) -> Vec<StageSummary> {
+        Stage::ALL
+            .iter()
+            .zip(times.shares())
+            .map(|(&stage, (name, share))| StageSummary {
+                stage: name.into(),
+                seconds: times.seconds(stage),
+                share,
+            })
+            .collect()
+    }
+}
 
 /// Figures of a finished (or interrupted) run, written as `summary.json`.
 #[derive(Clone, Debug, Default, Serialize)]
@@ -68,6 +95,8 @@ pub struct Summary {
     pub walls: Vec<WallSummary>,
     /// Threads used.
     pub threads: usize,
+    /// Wall-clock time of each stage of the steps, in step order.
+    pub stages: Vec<StageSummary>,
     /// The drum's averages, with a `[drum]` section.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub drum: Option<DrumSummary>,
@@ -238,7 +267,7 @@ impl RunOutput {
         writeln!(
             self.series_csv,
             "{t:.9e},{},{contacts},{:.9e},{max_speed:.9e},{}",
-            world.particles.len(),
+            world.particles.owned(),
             world.kinetic_energy(),
             world.particles.frozen_count()
         )?;

@@ -66,7 +66,7 @@ pub fn write_poses(dir: &Path, world: &World, shape_names: &[String]) -> io::Res
     let mut out = BufWriter::new(File::create(dir.join("poses.csv"))?);
     writeln!(out, "id,kind,shape,x,y,z,qw,qx,qy,qz")?;
     let p = &world.particles;
-    for i in 0..p.len() {
+    for i in 0..p.owned() {
         let (x, q) = (p.position[i], p.orientation[i]);
         let kind = p.body_type[i] as usize;
         writeln!(
@@ -158,7 +158,7 @@ pub fn write_bed_stl(dir: &Path, world: &World, shrink: Real) -> io::Result<()> 
     let mut vertices = Vec::new();
     let mut triangles = Vec::new();
     let mut balls = std::collections::HashMap::new();
-    for i in 0..p.len() {
+    for i in 0..p.owned() {
         let t = &world.body_types[p.body_type[i] as usize];
         let (local, tris): (Vec<Point3<Real>>, Vec<[usize; 3]>) = match &t.shape {
             Shape::Polyhedron(poly) => (

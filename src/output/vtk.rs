@@ -136,7 +136,7 @@ pub fn write_particles(world: &World, path: &Path) -> io::Result<()> {
     let (mut id, mut kind, mut vel, mut speed, mut omega) =
         (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
     let p = &world.particles;
-    for i in 0..p.len() {
+    for i in 0..p.owned() {
         let t = &world.body_types[p.body_type[i] as usize];
         let pose = nalgebra::Isometry3::from_parts(p.position[i].coords.into(), p.orientation[i]);
         let faces = match &t.shape {

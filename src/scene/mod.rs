@@ -16,6 +16,7 @@ pub mod poses;
 mod simulation;
 pub mod spec;
 pub mod state;
+pub mod state_bytes;
 
 use std::path::{Path, PathBuf};
 
@@ -23,7 +24,8 @@ pub use error::{FieldError, FieldPath, FieldSegment, SceneError};
 pub use plan::Plan;
 pub use simulation::{Simulation, StepReport};
 pub use spec::SceneSpec;
-pub use state::{StateError, StateReader, StateWriter};
+pub use state::{InletState, SimState, WallState};
+pub use state_bytes::{StateError, StateReader, StateWriter};
 
 use crate::Real;
 use crate::analysis::Drum;

@@ -1,24 +1,32 @@
 //! A running scene: world, engine and inlets advanced step by step, with the
 //! settling criterion.
 
+use std::ops::ControlFlow;
+
 use nalgebra::Vector3;
 
 use super::Scene;
 use super::spec::{FreezeSpec, SettleSpec};
 use crate::Real;
 use crate::analysis::packing::{Bed, bed_height_of};
-use crate::engine::step::Engine;
-use crate::world::{Inlet, World};
+use crate::engine::{Backend, CpuBackend, StageTimes, StepParams, StepStats};
+use crate::world::{Inlet, Wall, World};
 
-/// A scene being simulated.
-#[derive(Clone, Debug)]
+/// A scene being simulated: the host's world, the backend that steps it, and what
+/// the host does between steps (inlets, the bed's measurement and freezing, the
+/// settling clock).
+///
+/// # Invariant
+/// The world changes only through the methods here, and each change is reported to
+/// the backend through its sync calls (see [`crate::engine::backend`]).
+#[derive(Debug)]
 pub struct Simulation {
-    /// The state.
-    pub world: World,
-    /// The CPU engine (time step, contact history).
-    pub engine: Engine,
+    pub(super) world: World,
+    pub(super) backend: Box<dyn Backend>,
+    /// The step length asked for (the last step of an interval may be shorter).
+    pub(super) dt: Real,
     /// Particle sources.
-    pub inlets: Vec<Inlet>,
+    pub(super) inlets: Vec<Inlet>,
     /// Steps taken.
     pub steps: u64,
     /// End time of the run.
@@ -56,14 +64,21 @@ pub struct StepReport {
 }
 
 impl Simulation {
-    /// Starts a scene at time 0 (inlets insert what is due at 0).
+    /// Starts a scene at time 0 (inlets insert what is due at 0) on the CPU backend.
     pub fn new(scene: &Scene) -> Self {
-        let mut engine = Engine::new(scene.dt);
-        engine.regularisation_length = scene.spec.contact.regularisation;
-        engine.neighbours.skin = scene.spec.contact.skin;
+        let params = StepParams {
+            regularisation_length: scene.spec.contact.regularisation,
+            skin: scene.spec.contact.skin,
+        };
+        Self::with_backend(scene, Box::new(CpuBackend::new(params)))
+    }
+
+    /// Starts a scene at time 0 on `backend`, and evaluates the first forces.
+    pub fn with_backend(scene: &Scene, backend: Box<dyn Backend>) -> Self {
         let mut sim = Simulation {
             world: scene.world.clone(),
-            engine,
+            backend,
+            dt: scene.dt,
             inlets: scene.inlets.clone(),
             steps: 0,
             end_time: scene.spec.simulation.end_time,
@@ -75,8 +90,34 @@ impl Simulation {
             bed_height: None,
         };
         sim.insert();
-        sim.engine.initialise(&mut sim.world);
+        sim.backend.world_changed(&sim.world);
+        sim.initialise();
         sim
+    }
+
+    /// The host's world (see the sync contract of [`crate::engine::backend`]).
+    pub fn world(&self) -> &World {
+        &self.world
+    }
+
+    /// The backend.
+    pub fn backend(&self) -> &dyn Backend {
+        &*self.backend
+    }
+
+    /// Figures of the last force evaluation.
+    pub fn stats(&self) -> &StepStats {
+        self.backend.stats()
+    }
+
+    /// Time spent in each stage of the steps so far.
+    pub fn stage_times(&self) -> &StageTimes {
+        self.backend.stage_times()
+    }
+
+    /// Particle sources.
+    pub fn inlets(&self) -> &[Inlet] {
+        &self.inlets
     }
 
     /// Simulated time.
@@ -84,15 +125,119 @@ impl Simulation {
         self.world.time
     }
 
-    /// Whether the end time is reached.
-    pub fn is_finished(&self) -> bool {
-        self.world.time >= self.end_time - 1e-9 * self.engine.dt
+    /// The step length asked for.
+    pub fn dt(&self) -> Real {
+        self.dt
     }
 
-    /// Advances one time step, then lets inlets insert what is due.
+    /// Sets the step length of the steps to come.
+    pub fn set_time_step(&mut self, dt: Real) {
+        self.dt = dt;
+    }
+
+    /// The step parameters of the backend.
+    pub fn params(&self) -> StepParams {
+        *self.backend.params()
+    }
+
+    /// Replaces the step parameters of the backend.
+    pub fn set_params(&mut self, params: StepParams) {
+        self.backend.set_params(params);
+    }
+
+    /// Moves the clock to `t` without stepping: the start time of a co-simulation,
+    /// or the exact end of a communication step that the sub-steps reached to within
+    /// round-off.
+    pub fn set_time(&mut self, t: Real) {
+        self.world.time = t;
+    }
+
+    /// Evaluates the forces of the current state with the step length to come: after
+    /// the host set wall poses or velocities that the first half kick must see.
+    pub fn initialise(&mut self) {
+        self.backend.initialise(&mut self.world, self.dt);
+    }
+
+    /// Changes the walls (poses, velocities) through `change`; attached walls then
+    /// follow their leaders, and the backend is told.
+    pub fn move_walls(&mut self, change: impl FnOnce(&mut [Wall])) {
+        change(&mut self.world.walls);
+        self.world.follow_leaders();
+        self.backend.walls_moved(&self.world);
+    }
+
+    /// Multiplies every owned particle's velocity and angular momentum by `keep` (an
+    /// artificial drag that brings a bed to rest).
+    pub fn damp_velocities(&mut self, keep: Real) {
+        let p = &mut self.world.particles;
+        let n = p.owned();
+        p.velocity[..n].iter_mut().for_each(|v| *v *= keep);
+        p.angular_momentum[..n].iter_mut().for_each(|l| *l *= keep);
+        self.backend.velocities_set(&self.world);
+    }
+
+    /// Changes anything in the world through `change` (a test's or a benchmark's set
+    /// up: poses, velocities); the backend takes the whole world again and the forces
+    /// are evaluated anew.
+    pub fn edit_world(&mut self, change: impl FnOnce(&mut World)) {
+        change(&mut self.world);
+        self.world.particles.reindex();
+        self.backend.world_changed(&self.world);
+        self.initialise();
+    }
+
+    /// Removes the owned particles for which `remove` is true (given the world and the
+    /// particle's index); the others keep their order, and the backend finds what it
+    /// keeps per particle again by id. Returns how many were removed.
+    pub fn remove_particles(&mut self, mut remove: impl FnMut(&World, usize) -> bool) -> usize {
+        let world = &self.world;
+        let owned = world.particles.owned();
+        let doomed: Vec<bool> = (0..world.particles.len())
+            .map(|i| i < owned && remove(world, i))
+            .collect();
+        let removed = self.world.particles.remove_where(|i| doomed[i]);
+        if removed > 0 {
+            self.backend.particles_removed(&self.world);
+        }
+        removed
+    }
+
+    /// Whether the end time is reached.
+    pub fn is_finished(&self) -> bool {
+        self.world.time >= self.end_time - 1e-9 * self.dt
+    }
+
+    /// Advances one step of the step length asked for, then lets inlets insert what
+    /// is due.
     pub fn step(&mut self) {
+        self.step_by(self.dt);
+    }
+
+    /// Advances to `end` in steps of the step length asked for, the last one shortened
+    /// to land on `end`; stops within `1e-9` steps of it. After every step `each`
+    /// gets the simulation and the step's length, and may stop the advance
+    /// (`Break`), which is then returned.
+    ///
+    /// The one sub-step loop of talus: `talus run`, the Component (and so the C, FMI
+    /// and zenoh faces) and `talus bench` advance through it.
+    pub fn advance_to<B>(
+        &mut self,
+        end: Real,
+        mut each: impl FnMut(&Simulation, Real) -> ControlFlow<B>,
+    ) -> ControlFlow<B> {
+        while self.world.time < end - 1e-9 * self.dt {
+            let taken = self.dt.min(end - self.world.time);
+            self.step_by(taken);
+            each(self, taken)?;
+        }
+        ControlFlow::Continue(())
+    }
+
+    /// One step of length `dt`, then the host's work between steps.
+    fn step_by(&mut self, dt: Real) {
         let before = self.world.time;
-        self.engine.step(&mut self.world);
+        self.backend.step(&mut self.world, dt);
+        self.backend.sync_to_host(&mut self.world);
         self.steps += 1;
         self.follow_bed(before);
         self.insert();
@@ -110,6 +255,10 @@ impl Simulation {
         for i in first..p.len() {
             p.force[i] = self.world.gravity * self.world.body_types[p.body_type[i] as usize].mass;
             p.torque[i] = Vector3::zeros();
+        }
+        if p.len() > first {
+            self.backend
+                .particles_added(&self.world, first..self.world.particles.len());
         }
     }
 
@@ -132,14 +281,14 @@ impl Simulation {
         let w = &self.world;
         let p = &w.particles;
         let g = w.gravity.norm();
+        let touching = self.backend.touching();
         let member: Vec<bool> = (0..p.len())
             .map(|i| {
                 let d = 2.0
                     * w.body_types[p.body_type[i] as usize]
                         .shape
                         .equivalent_radius();
-                self.engine.touching().get(i) == Some(&true)
-                    && p.velocity[i].norm() < 0.5 * (g * d).sqrt()
+                touching.get(i) == Some(&true) && p.velocity[i].norm() < 0.5 * (g * d).sqrt()
             })
             .collect();
         let Ok(height) = bed_height_of(w, bed, &member, self.bed_height) else {
@@ -157,7 +306,10 @@ impl Simulation {
         // The pairs of frozen particles drop out of the force loop, not out of the
         // candidate lists: no rebuild is needed.
         if let Some(freeze) = &self.freeze {
-            freeze_buried(&mut self.world, bed, freeze, height, &member);
+            let frozen = freeze_buried(&mut self.world, bed, freeze, height, &member);
+            if !frozen.is_empty() {
+                self.backend.particles_frozen(&self.world, &frozen);
+            }
         }
     }
 
@@ -165,8 +317,8 @@ impl Simulation {
     pub fn report(&self) -> StepReport {
         StepReport {
             time: self.world.time,
-            particles: self.world.particles.len(),
-            contacts: self.engine.contacts,
+            particles: self.world.particles.owned(),
+            contacts: self.backend.stats().contacts,
             max_speed: self.max_speed(),
             kinetic_energy: self.world.kinetic_energy(),
         }
@@ -206,8 +358,15 @@ impl Simulation {
 }
 
 /// Freezes the particles in `member` (the bed) that are slower than the freeze speed
-/// and whose bounding sphere lies wholly more than the freeze depth below `height`.
-fn freeze_buried(world: &mut World, bed: &Bed, freeze: &FreezeSpec, height: Real, member: &[bool]) {
+/// and whose bounding sphere lies wholly more than the freeze depth below `height`;
+/// returns them.
+fn freeze_buried(
+    world: &mut World,
+    bed: &Bed,
+    freeze: &FreezeSpec,
+    height: Real,
+    member: &[bool],
+) -> Vec<usize> {
     let p = &world.particles;
     let buried: Vec<usize> = (0..p.len())
         .filter(|&i| {
@@ -217,7 +376,8 @@ fn freeze_buried(world: &mut World, bed: &Bed, freeze: &FreezeSpec, height: Real
                 && p.velocity[i].norm() < freeze.max_speed
         })
         .collect();
-    for i in buried {
+    for &i in &buried {
         world.particles.freeze(i);
     }
+    buried
 }

@@ -223,7 +223,7 @@ impl Default for ContactSpec {
 }
 
 fn default_regularisation() -> Real {
-    crate::engine::step::REGULARISATION_LENGTH
+    crate::engine::REGULARISATION_LENGTH
 }
 
 /// `[output]`.

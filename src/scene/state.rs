@@ -1,373 +1,208 @@
-//! The dynamic state of a [`Simulation`] as bytes, and back.
+//! The dynamic state of a [`Simulation`]: what a saved state, a rollback and a
+//! checkpoint hold (its bytes: [`super::state_bytes`]).
 //!
-//! What is saved is everything that evolves: particles (with this step's forces, which
-//! the next half kick uses, and whether they are frozen), wall poses, velocities and
-//! forces, the tangential contact history, inlet counters, box offsets and random
-//! generators, time, step count, the settling clock and the bed height last measured.
-//! What a scene defines once (materials, shapes, wall meshes and their facet grids) is
-//! not saved: a state is restored into a simulation of the same scene, and a
-//! fingerprint of that scene in the header refuses any other. Restoring and stepping
-//! on gives the same bits as never having saved.
-//!
-//! The format is little-endian, versioned by a magic string; every count is checked
-//! against what is left, so garbage bytes give an error, never a panic or a huge
-//! allocation.
+//! What is kept is everything that evolves: the owned particles (with this step's
+//! forces, which the next half kick uses, and whether they are frozen), wall poses,
+//! velocities and forces, the tangential contact history, inlet counters, box offsets
+//! and random generators, time, step count, the settling clock and the bed height last
+//! measured. What a scene defines once (materials, shapes, wall meshes and their facet
+//! grids) is not: a state is restored into a simulation of the same scene. Restoring
+//! and stepping on gives the same bits as never having saved.
 
-use nalgebra::{Isometry3, Point3, Quaternion, Translation3, UnitQuaternion, Vector3};
-use thiserror::Error;
+use nalgebra::{Isometry3, Vector3};
 
 use super::Simulation;
+use super::state_bytes::{StateError, StateReader, StateWriter};
 use crate::Real;
-use crate::contact::TangentialHistory;
-use crate::engine::step::ContactHistory;
+use crate::engine::{ContactHistory, StepStats};
+use crate::world::Particles;
 
-const MAGIC: &[u8; 8] = b"TALUSST3";
-
-/// Why bytes could not be restored as a state.
-#[derive(Debug, Error, PartialEq)]
-pub enum StateError {
-    /// Not a talus state (or one of another format version).
-    #[error("not a talus state (the bytes do not start with the state header)")]
-    NotAState,
-    /// A state of another scene.
-    #[error("the state belongs to another scene (fingerprint {found:#x}, expected {expected:#x})")]
-    OtherScene {
-        /// The fingerprint in the bytes.
-        found: u64,
-        /// The current scene's.
-        expected: u64,
-    },
-    /// The bytes end early or hold an impossible value.
-    #[error("corrupt state: {0}")]
-    Corrupt(String),
+/// Everything of a [`Simulation`] that evolves.
+#[derive(Clone, Debug)]
+pub struct SimState {
+    /// Simulated time.
+    pub time: Real,
+    /// The step length asked for.
+    pub dt: Real,
+    /// Steps taken.
+    pub steps: u64,
+    /// Id of the next inserted particle.
+    pub next_id: u64,
+    /// Since when the settling criterion holds.
+    pub quiet_since: Option<Real>,
+    /// The bed height last measured.
+    pub bed_height: Option<Real>,
+    /// Figures of the last force evaluation (contacts and elastic energy are kept).
+    pub stats: StepStats,
+    /// The owned particles.
+    pub particles: Particles,
+    /// Each wall's motion and forces.
+    pub walls: Vec<WallState>,
+    /// Each inlet's progress.
+    pub inlets: Vec<InletState>,
+    /// The tangential contact history.
+    pub history: ContactHistory,
 }
 
-/// Appends values to a byte buffer.
-#[derive(Debug, Default)]
-pub struct StateWriter {
-    bytes: Vec<u8>,
+/// What evolves of a wall.
+#[derive(Clone, Debug, PartialEq)]
+pub struct WallState {
+    /// Pose of the wall frame.
+    pub pose: Isometry3<Real>,
+    /// Velocity of the reference point.
+    pub velocity: Vector3<Real>,
+    /// Angular velocity about the reference point.
+    pub angular_velocity: Vector3<Real>,
+    /// Force of the last step.
+    pub force: Vector3<Real>,
+    /// Torque about the reference point of the last step.
+    pub torque: Vector3<Real>,
+    /// Force on each facet of the last step.
+    pub facet_force: Vec<Vector3<Real>>,
 }
 
-impl StateWriter {
-    /// The bytes written.
-    pub fn into_bytes(self) -> Vec<u8> {
-        self.bytes
-    }
-
-    /// An unsigned integer.
-    pub fn u64(&mut self, x: u64) {
-        self.bytes.extend_from_slice(&x.to_le_bytes());
-    }
-
-    /// A float, bit for bit.
-    pub fn f64(&mut self, x: Real) {
-        self.u64(x.to_bits());
-    }
-
-    /// A vector.
-    pub fn vec3(&mut self, v: &Vector3<Real>) {
-        v.iter().for_each(|x| self.f64(*x));
-    }
-
-    /// A quaternion (w, x, y, z).
-    pub fn quat(&mut self, q: &UnitQuaternion<Real>) {
-        [q.w, q.i, q.j, q.k].iter().for_each(|x| self.f64(*x));
-    }
-
-    /// A length-prefixed byte string.
-    pub fn blob(&mut self, b: &[u8]) {
-        self.u64(b.len() as u64);
-        self.bytes.extend_from_slice(b);
-    }
-}
-
-/// Reads values written by a [`StateWriter`].
-#[derive(Debug)]
-pub struct StateReader<'a> {
-    bytes: &'a [u8],
-    at: usize,
-}
-
-impl<'a> StateReader<'a> {
-    /// A reader at the start of `bytes`.
-    pub fn new(bytes: &'a [u8]) -> Self {
-        StateReader { bytes, at: 0 }
-    }
-
-    fn take(&mut self, n: usize) -> Result<&'a [u8], StateError> {
-        let end = self.at.checked_add(n).filter(|&e| e <= self.bytes.len());
-        let end = end.ok_or_else(|| {
-            StateError::Corrupt(format!(
-                "ends at byte {} of {} needed",
-                self.bytes.len(),
-                self.at + n
-            ))
-        })?;
-        let s = &self.bytes[self.at..end];
-        self.at = end;
-        Ok(s)
-    }
-
-    /// An unsigned integer.
-    pub fn u64(&mut self) -> Result<u64, StateError> {
-        Ok(u64::from_le_bytes(
-            self.take(8)?.try_into().expect("8 bytes"),
-        ))
-    }
-
-    /// A count of items of at least `item_bytes` each, checked against what is left.
-    pub fn count(&mut self, item_bytes: usize) -> Result<usize, StateError> {
-        let n = self.u64()?;
-        let left = (self.bytes.len() - self.at) as u64;
-        if n.saturating_mul(item_bytes.max(1) as u64) > left {
-            return Err(StateError::Corrupt(format!(
-                "a count of {n} at byte {} exceeds the {left} bytes left",
-                self.at - 8
-            )));
-        }
-        Ok(n as usize)
-    }
-
-    /// A float.
-    pub fn f64(&mut self) -> Result<Real, StateError> {
-        Ok(Real::from_bits(self.u64()?))
-    }
-
-    /// A vector.
-    pub fn vec3(&mut self) -> Result<Vector3<Real>, StateError> {
-        Ok(Vector3::new(self.f64()?, self.f64()?, self.f64()?))
-    }
-
-    /// A unit quaternion (stored as written, not renormalised).
-    pub fn quat(&mut self) -> Result<UnitQuaternion<Real>, StateError> {
-        let (w, i, j, k) = (self.f64()?, self.f64()?, self.f64()?, self.f64()?);
-        let q = Quaternion::new(w, i, j, k);
-        if !((q.norm() - 1.0).abs() < 1e-6) {
-            return Err(StateError::Corrupt(format!(
-                "orientation {q:?} is not a unit quaternion"
-            )));
-        }
-        Ok(UnitQuaternion::new_unchecked(q))
-    }
-
-    /// A length-prefixed byte string.
-    pub fn blob(&mut self) -> Result<&'a [u8], StateError> {
-        let n = self.count(1)?;
-        self.take(n)
-    }
-
-    /// Whether every byte was read.
-    pub fn is_done(&self) -> bool {
-        self.at == self.bytes.len()
-    }
-}
-
-fn write_history(w: &mut StateWriter, h: &TangentialHistory) {
-    w.vec3(&h.spring);
-    w.f64(h.stiffness);
-    w.f64(h.twist);
-}
-
-fn read_history(r: &mut StateReader) -> Result<TangentialHistory, StateError> {
-    Ok(TangentialHistory {
-        spring: r.vec3()?,
-        stiffness: r.f64()?,
-        twist: r.f64()?,
-    })
+/// What evolves of an inlet.
+#[derive(Clone, Debug, PartialEq)]
+pub struct InletState {
+    /// Particles inserted so far.
+    pub inserted: usize,
+    /// Particles to insert in all (lowered when the inlet is stopped).
+    pub count: usize,
+    /// Offset of the insertion box (an inlet riding above the bed).
+    pub offset: Vector3<Real>,
+    /// The random generator's state.
+    pub rng: Vec<u8>,
 }
 
 impl Simulation {
-    /// Writes the dynamic state, headed by the scene's `fingerprint`.
-    pub fn write_state(&self, fingerprint: u64, w: &mut StateWriter) {
-        w.bytes.extend_from_slice(MAGIC);
-        w.u64(fingerprint);
+    /// The state as it is now.
+    pub fn snapshot(&self) -> SimState {
         let world = &self.world;
-        w.f64(world.time);
-        w.f64(self.engine.dt);
-        w.u64(self.steps);
-        w.u64(self.next_id);
-        w.f64(self.quiet_since.unwrap_or(Real::NAN));
-        w.f64(self.bed_height.unwrap_or(Real::NAN));
-        w.u64(self.engine.contacts as u64);
-        w.f64(self.engine.elastic_energy);
+        SimState {
+            time: world.time,
+            dt: self.dt,
+            steps: self.steps,
+            next_id: self.next_id,
+            quiet_since: self.quiet_since,
+            bed_height: self.bed_height,
+            stats: *self.backend.stats(),
+            particles: world.particles.owned_only(),
+            walls: world
+                .walls
+                .iter()
+                .map(|w| WallState {
+                    pose: w.pose,
+                    velocity: w.velocity,
+                    angular_velocity: w.angular_velocity,
+                    force: w.force,
+                    torque: w.torque,
+                    facet_force: w.facet_force.clone(),
+                })
+                .collect(),
+            inlets: self
+                .inlets
+                .iter()
+                .map(|i| InletState {
+                    inserted: i.inserted,
+                    count: i.count,
+                    offset: i.offset,
+                    rng: i.rng_state(),
+                })
+                .collect(),
+            history: self.backend.contact_history(),
+        }
+    }
 
-        let p = &world.particles;
-        w.u64(p.len() as u64);
-        for i in 0..p.len() {
-            w.u64(p.id[i]);
-            w.u64(p.body_type[i] as u64);
-            w.vec3(&p.position[i].coords);
-            w.quat(&p.orientation[i]);
-            w.vec3(&p.velocity[i]);
-            w.vec3(&p.angular_momentum[i]);
-            w.vec3(&p.force[i]);
-            w.vec3(&p.torque[i]);
-            w.u64(p.frozen[i] as u64);
-        }
-
-        w.u64(world.walls.len() as u64);
-        for wall in &world.walls {
-            w.vec3(&wall.pose.translation.vector);
-            w.quat(&wall.pose.rotation);
-            w.vec3(&wall.velocity);
-            w.vec3(&wall.angular_velocity);
-            w.vec3(&wall.force);
-            w.vec3(&wall.torque);
-            w.u64(wall.facet_force.len() as u64);
-            wall.facet_force.iter().for_each(|f| w.vec3(f));
-        }
-
-        w.u64(self.inlets.len() as u64);
-        for inlet in &self.inlets {
-            w.u64(inlet.inserted as u64);
-            w.u64(inlet.count as u64);
-            w.vec3(&inlet.offset);
-            w.blob(&inlet.rng_state());
-        }
-
-        let history = self.engine.history();
-        w.u64(history.pairs.len() as u64);
-        for ((a, b), h) in &history.pairs {
-            w.u64(*a);
-            w.u64(*b);
-            write_history(w, h);
-        }
-        w.u64(history.walls.len() as u64);
-        for ((id, wall, plane), h) in &history.walls {
-            w.u64(*id);
-            w.u64(*wall as u64);
-            plane.iter().for_each(|x| w.u64(*x as u64));
-            write_history(w, h);
-        }
+    /// Writes the state as bytes headed by the scene's `fingerprint` (see
+    /// [`SimState::write`]).
+    pub fn write_state(&self, fingerprint: u64, w: &mut StateWriter) {
+        self.snapshot().write(fingerprint, w);
     }
 
     /// Restores a state written by [`Simulation::write_state`] for the scene with this
-    /// `fingerprint`, leaving the reader after it (the caller checks
-    /// [`StateReader::is_done`] or reads on). On error `self` is unchanged.
+    /// `fingerprint`, leaving the reader after it. On error nothing changed.
     pub fn read_state(&mut self, fingerprint: u64, r: &mut StateReader) -> Result<(), StateError> {
-        let mut next = self.clone();
-        next.read_state_into(fingerprint, r)?;
-        *self = next;
+        let state = SimState::read(fingerprint, r)?;
+        self.restore(&state)
+    }
+
+    /// Whether `state` fits this simulation's scene: its body types, walls, facets and
+    /// inlets.
+    pub fn check_state(&self, state: &SimState) -> Result<(), StateError> {
+        self.restored_inlets(state).map(|_| ())
+    }
+
+    /// Goes back to `state` (one of this scene, see [`Simulation::check_state`]); on
+    /// error nothing changed. The backend learns of it through its restore call.
+    pub fn restore(&mut self, state: &SimState) -> Result<(), StateError> {
+        let inlets = self.restored_inlets(state)?;
+        self.inlets = inlets;
+        let world = &mut self.world;
+        world.time = state.time;
+        world.particles = state.particles.clone();
+        for (wall, s) in world.walls.iter_mut().zip(&state.walls) {
+            wall.pose = s.pose;
+            wall.velocity = s.velocity;
+            wall.angular_velocity = s.angular_velocity;
+            wall.force = s.force;
+            wall.torque = s.torque;
+            wall.facet_force.clone_from(&s.facet_force);
+        }
+        self.dt = state.dt;
+        self.steps = state.steps;
+        self.next_id = state.next_id;
+        self.quiet_since = state.quiet_since;
+        self.bed_height = state.bed_height;
+        self.backend
+            .restore(&self.world, state.history.clone(), state.stats);
         Ok(())
     }
 
-    fn read_state_into(&mut self, fingerprint: u64, r: &mut StateReader) -> Result<(), StateError> {
-        if r.take(MAGIC.len()).ok() != Some(&MAGIC[..]) {
-            return Err(StateError::NotAState);
+    /// The inlets as `state` has them, after checking that it fits the scene.
+    fn restored_inlets(&self, state: &SimState) -> Result<Vec<crate::world::Inlet>, StateError> {
+        let corrupt = |m: String| Err(StateError::Corrupt(m));
+        let world = &self.world;
+        let types = world.body_types.len() as u64;
+        let p = &state.particles;
+        if let Some(i) = (0..p.len()).find(|&i| p.body_type[i] as u64 >= types) {
+            return corrupt(format!(
+                "particle {} has body type {}; the scene has {types}",
+                p.id[i], p.body_type[i]
+            ));
         }
-        let found = r.u64()?;
-        if found != fingerprint {
-            return Err(StateError::OtherScene {
-                found,
-                expected: fingerprint,
-            });
+        if state.walls.len() != world.walls.len() {
+            return corrupt(format!(
+                "{} walls; the scene has {}",
+                state.walls.len(),
+                world.walls.len()
+            ));
         }
-        self.world.time = r.f64()?;
-        self.engine.dt = r.f64()?;
-        self.steps = r.u64()?;
-        self.next_id = r.u64()?;
-        let quiet = r.f64()?;
-        self.quiet_since = (!quiet.is_nan()).then_some(quiet);
-        let height = r.f64()?;
-        self.bed_height = (!height.is_nan()).then_some(height);
-        self.engine.contacts = r.u64()? as usize;
-        self.engine.elastic_energy = r.f64()?;
-
-        let n = r.count(8 * 25)?;
-        let types = self.world.body_types.len() as u64;
-        let p = &mut self.world.particles;
-        *p = Default::default();
-        for _ in 0..n {
-            let id = r.u64()?;
-            let body_type = r.u64()?;
-            if body_type >= types {
-                return Err(StateError::Corrupt(format!(
-                    "particle {id} has body type {body_type}; the scene has {types}"
-                )));
-            }
-            p.push(
-                body_type as u32,
-                Point3::origin(),
-                UnitQuaternion::identity(),
-                id,
-            );
-            let i = p.len() - 1;
-            p.position[i] = Point3::from(r.vec3()?);
-            p.orientation[i] = r.quat()?;
-            p.velocity[i] = r.vec3()?;
-            p.angular_momentum[i] = r.vec3()?;
-            p.force[i] = r.vec3()?;
-            p.torque[i] = r.vec3()?;
-            p.frozen[i] = match r.u64()? {
-                0 => false,
-                1 => true,
-                x => {
-                    return Err(StateError::Corrupt(format!(
-                        "particle {id} has frozen flag {x}, not 0 or 1"
-                    )));
-                }
-            };
-        }
-
-        let walls = r.u64()?;
-        if walls != self.world.walls.len() as u64 {
-            return Err(StateError::Corrupt(format!(
-                "{walls} walls; the scene has {}",
-                self.world.walls.len()
-            )));
-        }
-        for wall in &mut self.world.walls {
-            let t = r.vec3()?;
-            let q = r.quat()?;
-            wall.pose = Isometry3::from_parts(Translation3::from(t), q);
-            wall.velocity = r.vec3()?;
-            wall.angular_velocity = r.vec3()?;
-            wall.force = r.vec3()?;
-            wall.torque = r.vec3()?;
-            let facets = r.count(24)?;
-            if facets != wall.facet_force.len() {
-                return Err(StateError::Corrupt(format!(
-                    "wall '{}' has {facets} facets in the state, {} in the scene",
+        for (wall, s) in world.walls.iter().zip(&state.walls) {
+            if s.facet_force.len() != wall.facet_force.len() {
+                return corrupt(format!(
+                    "wall '{}' has {} facets in the state, {} in the scene",
                     wall.name,
+                    s.facet_force.len(),
                     wall.facet_force.len()
-                )));
-            }
-            for f in &mut wall.facet_force {
-                *f = r.vec3()?;
+                ));
             }
         }
-
-        let inlets = r.u64()?;
-        if inlets != self.inlets.len() as u64 {
-            return Err(StateError::Corrupt(format!(
-                "{inlets} inlets; the scene has {}",
+        if state.inlets.len() != self.inlets.len() {
+            return corrupt(format!(
+                "{} inlets; the scene has {}",
+                state.inlets.len(),
                 self.inlets.len()
-            )));
+            ));
         }
-        for inlet in &mut self.inlets {
-            inlet.inserted = r.u64()? as usize;
-            inlet.count = r.u64()? as usize;
-            inlet.offset = r.vec3()?;
+        let mut inlets = self.inlets.clone();
+        for (inlet, s) in inlets.iter_mut().zip(&state.inlets) {
+            inlet.inserted = s.inserted;
+            inlet.count = s.count;
+            inlet.offset = s.offset;
             inlet
-                .set_rng_state(r.blob()?)
+                .set_rng_state(&s.rng)
                 .map_err(|e| StateError::Corrupt(format!("inlet generator: {e}")))?;
         }
-
-        let mut history = ContactHistory::default();
-        for _ in 0..r.count(8 * 7)? {
-            let key = (r.u64()?, r.u64()?);
-            history.pairs.push((key, read_history(r)?));
-        }
-        for _ in 0..r.count(8 * 11)? {
-            let id = r.u64()?;
-            let wall = r.u64()? as u32;
-            let mut plane = [0i64; 4];
-            for x in &mut plane {
-                *x = r.u64()? as i64;
-            }
-            history.walls.push(((id, wall, plane), read_history(r)?));
-        }
-        self.engine.set_history(history);
-        Ok(())
+        Ok(inlets)
     }
 }

@@ -56,7 +56,7 @@ impl Service {
     }
 
     fn time(&self) -> Real {
-        self.component.simulation().map_or(0.0, |s| s.world.time)
+        self.component.simulation().map_or(0.0, |s| s.world().time)
     }
 
     /// `<key>/step`: sets the wall inputs and steps; on any error nothing changes.
@@ -155,13 +155,13 @@ impl Service {
         Ok(StepReply {
             status: pb::Status::Ok as i32,
             error: String::new(),
-            time: sim.world.time,
+            time: sim.world().time,
             walls,
             globals: Some(pb::Globals {
-                particles: sim.world.particles.len() as u64,
-                contacts: sim.engine.contacts as u64,
-                kinetic_energy: sim.world.kinetic_energy(),
-                max_speed: sim.world.max_speed(),
+                particles: sim.world().particles.len() as u64,
+                contacts: sim.stats().contacts as u64,
+                kinetic_energy: sim.world().kinetic_energy(),
+                max_speed: sim.world().max_speed(),
             }),
             sequence: self.sequence,
         })
@@ -196,7 +196,7 @@ impl Service {
                     .component
                     .simulation()
                     .map_or(self.component.scene().world.walls[w].pose, |s| {
-                        s.world.walls[w].pose
+                        s.world().walls[w].pose
                     });
                 let q = pose.rotation;
                 walls.push(pb::WallMesh {
@@ -292,7 +292,7 @@ impl Service {
             status: pb::Status::Ok as i32,
             error: String::new(),
             scene: c.scene().file.display().to_string(),
-            dt: c.simulation().map_or(c.scene().dt, |s| s.engine.dt),
+            dt: c.simulation().map_or(c.scene().dt, |s| s.dt()),
             time: self.time(),
             walls,
             variables,

@@ -3,17 +3,19 @@
 
 mod inlet;
 mod motion;
+mod particles;
 mod walls;
 
-use nalgebra::{Point3, UnitQuaternion, Vector3};
+use nalgebra::Vector3;
 
 pub use inlet::{Inlet, PLACEMENT_ATTEMPTS, is_free, random_orientation};
 pub use motion::{DriveInput, MotionKey, WallMotion, WallVelocity, advance_pose};
+pub use particles::Particles;
 pub use walls::{FacetGrid, Wall};
 
 use crate::Real;
 use crate::contact::Material;
-use crate::geometry::Shape;
+use crate::geometry::{Shape, is_isotropic};
 
 /// A particle template with a material: what particles of one kind share.
 #[derive(Clone, Debug)]
@@ -40,77 +42,6 @@ impl BodyType {
     }
 }
 
-/// Particle state, one entry per particle in every array.
-#[derive(Clone, Debug, Default)]
-pub struct Particles {
-    /// Centroid positions.
-    pub position: Vec<Point3<Real>>,
-    /// Orientations (body frame to world).
-    pub orientation: Vec<UnitQuaternion<Real>>,
-    /// Linear velocities.
-    pub velocity: Vec<Vector3<Real>>,
-    /// Angular momenta in the world frame.
-    pub angular_momentum: Vec<Vector3<Real>>,
-    /// Forces of the current step.
-    pub force: Vec<Vector3<Real>>,
-    /// Torques about the centroid of the current step.
-    pub torque: Vec<Vector3<Real>>,
-    /// Index into [`World::body_types`].
-    pub body_type: Vec<u32>,
-    /// Stable identifier (survives reordering; keys the contact history).
-    pub id: Vec<u64>,
-    /// Whether the particle is frozen (see [`Particles::freeze`]): it keeps its pose,
-    /// its velocity and angular momentum are zero, and only particles that are not
-    /// frozen feel its contacts.
-    pub frozen: Vec<bool>,
-}
-
-impl Particles {
-    /// Number of particles.
-    pub fn len(&self) -> usize {
-        self.position.len()
-    }
-
-    /// Whether there are none.
-    pub fn is_empty(&self) -> bool {
-        self.position.is_empty()
-    }
-
-    /// Appends a particle at rest.
-    pub fn push(
-        &mut self,
-        body_type: u32,
-        position: Point3<Real>,
-        orientation: UnitQuaternion<Real>,
-        id: u64,
-    ) {
-        self.position.push(position);
-        self.orientation.push(orientation);
-        self.velocity.push(Vector3::zeros());
-        self.angular_momentum.push(Vector3::zeros());
-        self.force.push(Vector3::zeros());
-        self.torque.push(Vector3::zeros());
-        self.body_type.push(body_type);
-        self.id.push(id);
-        self.frozen.push(false);
-    }
-
-    /// Freezes particle `i`: it stops and is no longer integrated; its contacts with
-    /// other frozen particles are skipped and its wall contacts too, while a particle
-    /// that is not frozen still rests on it. What a long packing run uses for the
-    /// buried part of a bed, whose structure no longer changes (see `[bed] freeze`).
-    pub fn freeze(&mut self, i: usize) {
-        self.frozen[i] = true;
-        self.velocity[i] = Vector3::zeros();
-        self.angular_momentum[i] = Vector3::zeros();
-    }
-
-    /// Number of frozen particles.
-    pub fn frozen_count(&self) -> usize {
-        self.frozen.iter().filter(|&&f| f).count()
-    }
-}
-
 /// Everything that evolves or is looked up during a step.
 #[derive(Clone, Debug, Default)]
 pub struct World {
@@ -133,7 +64,7 @@ impl World {
     pub fn angular_velocity(&self, i: usize) -> Vector3<Real> {
         let p = &self.particles;
         let inertia = &self.body_types[p.body_type[i] as usize].inertia;
-        if crate::engine::integrate::is_isotropic(inertia) {
+        if is_isotropic(inertia) {
             return p.angular_momentum[i] / inertia.x;
         }
         let q = p.orientation[i];
@@ -142,10 +73,9 @@ impl World {
             .component_div(inertia)
     }
 
-    /// Largest particle speed (translation).
+    /// Largest speed (translation) of the owned particles.
     pub fn max_speed(&self) -> Real {
-        self.particles
-            .velocity
+        self.particles.velocity[..self.particles.owned()]
             .iter()
             .map(|v| v.norm())
             .fold(0.0, Real::max)
@@ -169,10 +99,10 @@ impl World {
         }
     }
 
-    /// Total kinetic energy (translation and rotation).
+    /// Total kinetic energy (translation and rotation) of the owned particles.
     pub fn kinetic_energy(&self) -> Real {
         let p = &self.particles;
-        (0..p.len())
+        (0..p.owned())
             .map(|i| {
                 let t = &self.body_types[p.body_type[i] as usize];
                 let lb = p.orientation[i].inverse_transform_vector(&p.angular_momentum[i]);

@@ -78,7 +78,7 @@ pub fn settle(
     while !sim.is_settled() && sim.time() < limit {
         sim.step();
     }
-    let p = &sim.world.particles;
+    let p = &sim.world().particles;
     println!(
         "{} particles, dt = {:.3e} s: settled = {} at t = {:.3} s after {} steps, largest speed {:.2e} m/s, {} contacts",
         p.len(),
@@ -87,7 +87,7 @@ pub fn settle(
         sim.time(),
         sim.steps,
         sim.max_speed(),
-        sim.engine.contacts
+        sim.stats().contacts
     );
     for i in 0..p.len() {
         let x = p.position[i];

@@ -1,6 +1,7 @@
 //! `talus check` and `talus run`: validate a scene, print its plan, and run it with
 //! progress, ParaView output, CSV series and a summary.
 
+use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -8,7 +9,7 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
-use talus::output::{RunOutput, Summary, WallSummary};
+use talus::output::{RunOutput, StageSummary, Summary, WallSummary};
 use talus::scene::{Scene, Simulation};
 
 /// Loads a scene, printing its warnings.
@@ -74,13 +75,13 @@ fn run_loop(
     let mut sim = Simulation::new(scene);
     let mut out = RunOutput::create(
         dir,
-        &sim.world,
+        sim.world(),
         scene.spec.output.frame_interval,
         scene.spec.output.csv_interval,
         scene.drum.as_ref(),
     )
     .with_context(|| format!("cannot write to {}", dir.display()))?;
-    out.record(&sim.world, 0.0, sim.engine.contacts, true)?;
+    out.record(sim.world(), 0.0, sim.stats().contacts, true)?;
     let total_steps = (sim.end_time / scene.dt).ceil() as u64;
     let bar = if quiet {
         ProgressBar::hidden()
@@ -95,41 +96,51 @@ fn run_loop(
     let mut contact_sum = 0u64;
     let mut particle_steps = 0u64;
     let mut last_draw = Instant::now();
-    let ended_by = loop {
+    // What ends a run, in this order: Ctrl-C, the end time, the settling criterion.
+    let stopped = |sim: &Simulation| {
         if stop.load(Ordering::SeqCst) {
-            break "interrupted";
+            Some("interrupted")
+        } else if !sim.is_finished() && sim.is_settled() {
+            Some("settled")
+        } else {
+            None
         }
-        if sim.is_finished() {
-            break "end_time";
-        }
-        if sim.is_settled() {
-            break "settled";
-        }
-        // Land on the end time exactly.
-        let remaining = sim.end_time - sim.time();
-        let dt = scene.dt;
-        let taken = dt.min(remaining);
-        sim.engine.dt = taken;
-        let p = &sim.world.particles;
-        particle_steps += (p.len() - p.frozen_count()) as u64;
-        sim.step();
-        sim.engine.dt = dt;
-        contact_sum += sim.engine.contacts as u64;
-        out.record(&sim.world, taken, sim.engine.contacts, false)?;
-        if last_draw.elapsed() > Duration::from_millis(200) {
-            last_draw = Instant::now();
-            bar.set_position(sim.steps);
-            bar.set_message(format!(
-                "{:.4e} s | {} particles | {} contacts",
-                sim.time(),
-                sim.world.particles.len(),
-                sim.engine.contacts
-            ));
+    };
+    let ended_by = match stopped(&sim) {
+        Some(reason) => reason,
+        None => {
+            let end = sim.end_time;
+            let advanced = sim.advance_to(end, |sim, taken| {
+                let stats = sim.stats();
+                particle_steps += stats.integrated as u64;
+                contact_sum += stats.contacts as u64;
+                if let Err(e) = out.record(sim.world(), taken, stats.contacts, false) {
+                    return ControlFlow::Break(Err(e));
+                }
+                if last_draw.elapsed() > Duration::from_millis(200) {
+                    last_draw = Instant::now();
+                    bar.set_position(sim.steps);
+                    bar.set_message(format!(
+                        "{:.4e} s | {} particles | {} contacts",
+                        sim.time(),
+                        sim.world().particles.owned(),
+                        stats.contacts
+                    ));
+                }
+                match stopped(sim) {
+                    Some(reason) => ControlFlow::Break(Ok(reason)),
+                    None => ControlFlow::Continue(()),
+                }
+            });
+            match advanced {
+                ControlFlow::Continue(()) => "end_time",
+                ControlFlow::Break(reason) => reason?,
+            }
         }
     };
     bar.finish_and_clear();
-    out.record(&sim.world, 0.0, sim.engine.contacts, true)?;
-    let drum = out.finish(&sim.world)?;
+    out.record(sim.world(), 0.0, sim.stats().contacts, true)?;
+    let drum = out.finish(sim.world())?;
     let elapsed = started.elapsed().as_secs_f64();
     let report = sim.report();
     let summary = Summary {
@@ -145,7 +156,7 @@ fn run_loop(
         steps: sim.steps,
         wall_clock_s: elapsed,
         particles: report.particles,
-        frozen: sim.world.particles.frozen_count(),
+        frozen: sim.world().particles.frozen_count(),
         contacts: report.contacts,
         particle_steps_per_s: particle_steps as f64 / elapsed.max(1e-9),
         contacts_per_s: contact_sum as f64 / elapsed.max(1e-9),
@@ -153,7 +164,7 @@ fn run_loop(
         max_speed: report.max_speed,
         frames: out.frames(),
         walls: sim
-            .world
+            .world()
             .walls
             .iter()
             .map(|w| WallSummary {
@@ -163,11 +174,12 @@ fn run_loop(
             })
             .collect(),
         threads,
+        stages: StageSummary::of(sim.stage_times()),
         drum,
     };
     out.write_summary(&summary)?;
     if let Some(bed) = &scene.bed {
-        crate::analyze::write_bed_files(scene, bed, &sim.world, dir)?;
+        crate::analyze::write_bed_files(scene, bed, sim.world(), dir)?;
     }
     println!(
         "{}: {} at t = {:.6e} s after {} steps in {:.2} s ({:.3e} particle-steps/s, {:.3e} contacts/s); {} particles; output in {}",

@@ -53,7 +53,7 @@ pub fn serve(scene: &Path, options: ServeOptions) -> Result<()> {
     }
     let mut service = node.stop();
     let component = service.component_mut();
-    let time = component.simulation().map_or(0.0, |s| s.world.time);
+    let time = component.simulation().map_or(0.0, |s| s.world().time);
     component.terminate()?;
     println!("stopped at t = {time} s; outputs in {}", out.display());
     Ok(())

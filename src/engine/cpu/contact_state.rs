@@ -1,0 +1,82 @@
+//! What the CPU backend keeps of its contacts from step to step: the tangential
+//! history of every candidate pair and wall patch, and the overlap decisions that
+//! only change the cost.
+
+use crate::Real;
+use crate::contact::TangentialHistory;
+use crate::engine::backend::{ContactHistory, WallKey};
+use crate::engine::fast_hash::FastMap;
+use crate::engine::neighbours::NeighbourList;
+use crate::geometry::overlap::OverlapCache;
+use crate::world::World;
+
+/// Persistent contact state, aligned with a [`NeighbourList`].
+///
+/// # Invariant
+/// `pair_history[k]` and `overlap_plans[k]` belong to `list.pairs()[k]` of the list
+/// last built, unless `pending` holds a history set from outside, which is matched to
+/// the pairs (by particle ids) at the next build and until then is the history.
+#[derive(Clone, Debug, Default)]
+pub(super) struct ContactState {
+    /// Tangential history of each candidate pair.
+    pub pair_history: Vec<TangentialHistory>,
+    /// What each candidate pair's exact overlap decided at some pose: it changes the
+    /// cost, never the answer (see [`OverlapCache`]), so it is neither saved nor
+    /// carried over a list build.
+    pub overlap_plans: Vec<OverlapCache>,
+    /// History set from outside, to be matched to the pairs at the next list build.
+    pending: Option<FastMap<(u64, u64), TangentialHistory>>,
+    /// History of the particle–wall patches of the last step.
+    pub wall_history: FastMap<WallKey, TangentialHistory>,
+}
+
+impl ContactState {
+    /// The tangential history of the particle pairs, keyed by the two ids.
+    fn pair_history_by_ids(&self, list: &NeighbourList) -> FastMap<(u64, u64), TangentialHistory> {
+        if let Some(pending) = &self.pending {
+            return pending.clone();
+        }
+        list.pairs()
+            .iter()
+            .zip(&self.pair_history)
+            .filter(|(_, h)| !h.is_empty())
+            .map(|(&pair, h)| (list.pair_ids(pair), *h))
+            .collect()
+    }
+
+    /// The whole history, sorted by key.
+    pub fn history(&self, list: &NeighbourList) -> ContactHistory {
+        let mut pairs: Vec<_> = self.pair_history_by_ids(list).into_iter().collect();
+        let mut walls: Vec<_> = self.wall_history.iter().map(|(k, h)| (*k, *h)).collect();
+        pairs.sort_by_key(|e| e.0);
+        walls.sort_by_key(|e| e.0);
+        ContactHistory { pairs, walls }
+    }
+
+    /// Replaces the history; `list` must be rebuilt before it is used again.
+    pub fn set_history(&mut self, history: ContactHistory, list: &mut NeighbourList) {
+        self.pending = Some(history.pairs.into_iter().collect());
+        list.invalidate();
+        self.wall_history = history.walls.into_iter().collect();
+    }
+
+    /// Rebuilds `list` for `world` (`radii`: bounding radii), carrying each pair's
+    /// history over by the two particle ids.
+    pub fn rebuild(&mut self, list: &mut NeighbourList, world: &World, radii: &[Real]) {
+        let carried = match self.pending.take() {
+            Some(pending) => pending,
+            None => self.pair_history_by_ids(list),
+        };
+        list.build(world, radii);
+        self.overlap_plans.clear();
+        self.overlap_plans
+            .resize(list.pairs().len(), OverlapCache::default());
+        self.pair_history.clear();
+        self.pair_history.extend(list.pairs().iter().map(|&pair| {
+            carried
+                .get(&list.pair_ids(pair))
+                .copied()
+                .unwrap_or_default()
+        }));
+    }
+}

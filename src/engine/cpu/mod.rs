@@ -1,0 +1,232 @@
+//! The CPU backend (rayon): the reference implementation of [`Backend`].
+//!
+//! A step is kick and drift, the walls' prescribed motion, the force evaluation
+//! (contact laws, neighbour list, pair contacts, gather, wall contacts) and the
+//! closing kick: [`CpuBackend::step`] and [`CpuBackend::evaluate_forces`] list the
+//! stages in order, each a data-parallel loop over particles, pairs or particle
+//! chunks that writes its own slot, timed by [`StageTimes`]. Each particle gathers its
+//! pairs' forces in pair order and wall contacts are added in particle order, so the
+//! results do not depend on the number of threads.
+//!
+//! The parts: [`motion`] (integration stages), [`pairs`] (pair contacts and gather),
+//! [`walls`] (wall stage), [`dispatch`] (shape pair → contact geometry), [`patch`]
+//! (coplanar facets merged into one contact), [`forces`] (geometry → force through
+//! the contact laws), [`contact_state`] (what persists between steps).
+
+mod contact_state;
+mod dispatch;
+mod forces;
+mod motion;
+mod pairs;
+mod patch;
+mod walls;
+
+use std::ops::Range;
+
+use self::contact_state::ContactState;
+use self::forces::ContactForce;
+use self::walls::WallWork;
+use super::backend::{Backend, ContactHistory};
+use super::laws::ContactLaws;
+use super::neighbours::NeighbourList;
+use super::params::StepParams;
+use super::stats::{Stage, StageTimes, StepStats};
+use crate::Real;
+use crate::world::World;
+
+/// Buffers a step reuses: nothing in them survives from one step to the next except
+/// their capacity (and the touching flags, read by the host).
+#[derive(Clone, Debug, Default)]
+struct Workspace {
+    /// Bounding radius of every particle.
+    radii: Vec<Real>,
+    /// The pair results, aligned with the pair list.
+    results: Vec<Option<ContactForce>>,
+    /// Whether each particle touched another or a wall at the last force evaluation.
+    touching: Vec<bool>,
+    walls: WallWork,
+}
+
+/// The CPU engine: step parameters, persistent contact state, the neighbour list, the
+/// contact-law table, scratch buffers and statistics.
+#[derive(Clone, Debug, Default)]
+pub struct CpuBackend {
+    params: StepParams,
+    list: NeighbourList,
+    contacts: ContactState,
+    laws: ContactLaws,
+    work: Workspace,
+    stats: StepStats,
+    times: StageTimes,
+}
+
+impl CpuBackend {
+    /// A backend with `params`.
+    pub fn new(params: StepParams) -> Self {
+        let mut backend = CpuBackend::default();
+        backend.set_params(params);
+        backend
+    }
+
+    /// The neighbour lists (for tests and reports).
+    pub fn neighbours(&self) -> &NeighbourList {
+        &self.list
+    }
+
+    /// Forces and torques of the current positions and velocities, stage by stage.
+    fn evaluate_forces(&mut self, world: &mut World, dt: Real) {
+        let Self {
+            params,
+            list,
+            contacts,
+            laws,
+            work,
+            stats,
+            times,
+        } = self;
+        times.time(Stage::Laws, || {
+            laws.prepare(world, params.regularisation_length)
+        });
+        times.time(Stage::NeighbourList, || {
+            update_list(list, contacts, world, &mut work.radii)
+        });
+        times.time(Stage::PairContacts, || {
+            pairs::pair_contacts(
+                world,
+                list,
+                contacts,
+                &work.radii,
+                laws,
+                dt,
+                &mut work.results,
+            )
+        });
+        let totals = times.time(Stage::Gather, || {
+            pairs::gather(world, list, &work.results, &mut work.touching)
+        });
+        let pair_contacts = totals.0;
+        let (count, energy) = times.time(Stage::WallContacts, || {
+            walls::wall_contacts(
+                world,
+                list,
+                laws,
+                params.regularisation_length,
+                dt,
+                &mut contacts.wall_history,
+                &mut work.walls,
+                &mut work.touching,
+                totals,
+            )
+        });
+        stats.contacts = count;
+        stats.pair_contacts = pair_contacts;
+        stats.elastic_energy = energy;
+        stats.candidate_pairs = list.pairs().len();
+        stats.list_builds = list.builds();
+    }
+}
+
+/// Brings the candidate lists up to date (the radii are refreshed every step: the
+/// body types of the particles may have changed), carrying the pairs' tangential
+/// history over to a new list.
+fn update_list(
+    list: &mut NeighbourList,
+    contacts: &mut ContactState,
+    world: &World,
+    radii: &mut Vec<Real>,
+) {
+    let types = &world.body_types;
+    radii.clear();
+    radii.extend(
+        world
+            .particles
+            .body_type
+            .iter()
+            .map(|&k| types[k as usize].shape.circumradius()),
+    );
+    if list.is_stale(world) {
+        contacts.rebuild(list, world, radii);
+    }
+}
+
+impl Backend for CpuBackend {
+    fn name(&self) -> &'static str {
+        "cpu"
+    }
+
+    fn params(&self) -> &StepParams {
+        &self.params
+    }
+
+    fn set_params(&mut self, params: StepParams) {
+        if params.skin != self.params.skin {
+            self.list.invalidate();
+        }
+        self.list.skin = params.skin;
+        self.params = params;
+    }
+
+    fn initialise(&mut self, world: &mut World, dt: Real) {
+        self.evaluate_forces(world, dt);
+    }
+
+    /// One velocity-Verlet step: the stages in order.
+    fn step(&mut self, world: &mut World, dt: Real) {
+        let integrated = self
+            .times
+            .time(Stage::Integrate, || motion::kick_drift(world, dt));
+        self.times
+            .time(Stage::WallMotion, || motion::advance_walls(world, dt));
+        self.evaluate_forces(world, dt);
+        self.times
+            .time(Stage::Integrate, || motion::closing_kick(world, dt));
+        self.stats.integrated = integrated;
+    }
+
+    fn stats(&self) -> &StepStats {
+        &self.stats
+    }
+
+    fn stage_times(&self) -> &StageTimes {
+        &self.times
+    }
+
+    fn touching(&self) -> &[bool] {
+        &self.work.touching
+    }
+
+    /// The list sees new ids and rebuilds itself at the next step.
+    fn particles_added(&mut self, _world: &World, _added: Range<usize>) {}
+
+    /// Frozen pairs drop out of the force loop, not out of the candidate lists: no
+    /// rebuild is needed.
+    fn particles_frozen(&mut self, _world: &World, _frozen: &[usize]) {}
+
+    fn particles_removed(&mut self, _world: &World) {
+        self.list.invalidate();
+    }
+
+    fn velocities_set(&mut self, _world: &World) {}
+
+    /// The lists are checked against the walls' frames every step.
+    fn walls_moved(&mut self, _world: &World) {}
+
+    fn world_changed(&mut self, _world: &World) {
+        self.list.invalidate();
+    }
+
+    fn contact_history(&self) -> ContactHistory {
+        self.contacts.history(&self.list)
+    }
+
+    fn restore(&mut self, _world: &World, history: ContactHistory, stats: StepStats) {
+        self.contacts.set_history(history, &mut self.list);
+        self.stats = StepStats {
+            list_builds: self.stats.list_builds,
+            ..stats
+        };
+    }
+
+    /// The CPU backend works on the host world itself.
+    fn sync_to_host(&mut self, _world: &mut World) {}
+}

@@ -1,0 +1,97 @@
+//! Wall patches: the facets of one wall that a particle touches, merged by plane, so
+//! that a flat wall made of many triangles acts as one contact whatever its
+//! triangulation.
+
+use nalgebra::{Point3, Vector3};
+
+use super::dispatch::ContactGeometry;
+use crate::Real;
+
+/// How the facets of one plane combine into the patch's contact.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Merge {
+    /// Polyhedra: the facets' prisms tile the patch; their volumes, area vectors and
+    /// rotation gradients add.
+    Sum,
+    /// Spheres: the deepest facet of a flat patch is the plane contact.
+    Deepest,
+}
+
+/// The plane key of a facet with unit normal `n` through `point`, for a particle of
+/// bounding radius `radius`: facets sharing a plane (to 1e-9 in the normal and 1e-9
+/// radii in offset) share a key.
+pub(super) fn plane_key(n: &Vector3<Real>, point: &Point3<Real>, radius: Real) -> [i64; 4] {
+    [
+        (n.x * 1e9).round() as i64,
+        (n.y * 1e9).round() as i64,
+        (n.z * 1e9).round() as i64,
+        (n.dot(&point.coords) / radius * 1e9).round() as i64,
+    ]
+}
+
+/// The patches of one particle against one wall, being assembled. Buffers are kept
+/// between uses: after the first few steps assembling allocates nothing.
+#[derive(Clone, Debug, Default)]
+pub(super) struct PatchSet {
+    /// Plane key and summed geometry of each patch in use.
+    patches: Vec<([i64; 4], ContactGeometry)>,
+    /// Facets of each patch with their shares of the overlap (volumes); entries past
+    /// `patches.len()` are spare buffers.
+    shares: Vec<Vec<(u32, Real)>>,
+}
+
+impl PatchSet {
+    /// Empties the set, keeping its buffers.
+    pub(super) fn clear(&mut self) {
+        self.patches.clear();
+    }
+
+    /// Adds facet `f`'s contact `g` to the patch of plane `key`.
+    pub(super) fn add(&mut self, key: [i64; 4], f: u32, g: ContactGeometry, merge: Merge) {
+        let Some(k) = self.patches.iter().position(|(pk, _)| *pk == key) else {
+            let k = self.patches.len();
+            self.patches.push((key, g));
+            if self.shares.len() == k {
+                self.shares.push(Vec::new());
+            }
+            self.shares[k].clear();
+            self.shares[k].push((f, g.volume));
+            return;
+        };
+        let (acc, shares) = (&mut self.patches[k].1, &mut self.shares[k]);
+        match merge {
+            Merge::Sum => {
+                let v = acc.volume + g.volume;
+                acc.point =
+                    Point3::from((acc.point.coords * acc.volume + g.point.coords * g.volume) / v);
+                let sum = acc.normal * acc.area + g.normal * g.area;
+                acc.area = sum.norm();
+                acc.normal = sum / acc.area;
+                acc.volume = v;
+                acc.depth = acc.depth.max(g.depth);
+                acc.rotation_gradient = acc
+                    .rotation_gradient
+                    .zip(g.rotation_gradient)
+                    .map(|(a, b)| a + b);
+                shares.push((f, g.volume));
+            }
+            Merge::Deepest => {
+                if g.depth > acc.depth {
+                    *acc = g;
+                    shares.clear();
+                    shares.push((f, 1.0));
+                }
+            }
+        }
+    }
+
+    /// The patches in the order they were opened: key, geometry, facet shares.
+    pub(super) fn iter(
+        &self,
+    ) -> impl Iterator<Item = ([i64; 4], &ContactGeometry, &[(u32, Real)])> {
+        self.patches
+            .iter()
+            .zip(&self.shares)
+            .map(|((key, g), shares)| (*key, g, shares.as_slice()))
+    }
+}

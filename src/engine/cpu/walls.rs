@@ -1,0 +1,212 @@
+//! The wall stage: every owned, moving particle against the facets its neighbour list
+//! names, one contact per coplanar patch, in parallel over fixed chunks of particles;
+//! then the contacts are added to particles, walls and facets in particle order.
+//!
+//! The chunks keep their buffers between steps, so the stage allocates nothing once
+//! the buffers have grown to the bed's needs.
+
+use std::ops::Range;
+
+use nalgebra::Vector3;
+use rayon::prelude::*;
+
+use super::dispatch::{facet_geometry, pose_of};
+use super::forces::{
+    ContactForce, LawInputs, RelativeMotion, contact_force, inverse_mass_at, velocity_at,
+};
+use super::patch::{Merge, PatchSet, plane_key};
+use crate::Real;
+use crate::contact::{PairStiffness, TangentialHistory};
+use crate::engine::backend::WallKey;
+use crate::engine::fast_hash::FastMap;
+use crate::engine::laws::{ContactLaws, pair_restitution};
+use crate::engine::neighbours::NeighbourList;
+use crate::geometry::Shape;
+use crate::world::World;
+
+/// Particles per chunk of the wall stage. The particles touching a wall are bunched
+/// (a bed sorted by height has its whole floor layer first), so chunks are small
+/// enough for two threads to share the floor; a particle's wall contacts can cost as
+/// much as a hundred kick–drifts (a pellet against the facets of a tube).
+const PARTICLES_PER_CHUNK: usize = 64;
+
+/// One particle–wall contact: a coplanar patch of one wall's facets.
+#[derive(Clone, Debug)]
+struct WallContact {
+    particle: u32,
+    wall: u32,
+    key: WallKey,
+    force: ContactForce,
+    /// The patch's facets with their shares of the overlap, in the chunk's `shares`.
+    shares: Range<usize>,
+}
+
+/// The wall contacts of one chunk of particles, in particle order.
+#[derive(Clone, Debug, Default)]
+pub(super) struct WallChunk {
+    contacts: Vec<WallContact>,
+    shares: Vec<(u32, Real)>,
+    patches: PatchSet,
+}
+
+/// The stage's buffers.
+#[derive(Clone, Debug, Default)]
+pub(super) struct WallWork {
+    chunks: Vec<WallChunk>,
+    /// The patches' history being written this step (swapped with the kept one).
+    next_history: FastMap<WallKey, TangentialHistory>,
+}
+
+/// Evaluates and applies the wall contacts: particle forces and torques, wall forces,
+/// torques and facet forces, the touching flags; replaces `history` by the patches'
+/// new history. Adds the number of contacts and their elastic energy to `totals`
+/// (the pairs' figures: the energy is summed on in the same order as ever).
+pub(super) fn wall_contacts(
+    world: &mut World,
+    list: &NeighbourList,
+    laws: &ContactLaws,
+    regularisation_length: Real,
+    dt: Real,
+    history: &mut FastMap<WallKey, TangentialHistory>,
+    work: &mut WallWork,
+    touching: &mut [bool],
+    totals: (usize, Real),
+) -> (usize, Real) {
+    for wall in &mut world.walls {
+        wall.force = Vector3::zeros();
+        wall.torque = Vector3::zeros();
+        wall.facet_force
+            .iter_mut()
+            .for_each(|f| *f = Vector3::zeros());
+    }
+    let n = world.particles.len();
+    let chunks = n.div_ceil(PARTICLES_PER_CHUNK);
+    if work.chunks.len() < chunks {
+        work.chunks.resize_with(chunks, WallChunk::default);
+    }
+    let w = &*world;
+    let kept = &*history;
+    work.chunks[..chunks]
+        .par_iter_mut()
+        .enumerate()
+        .for_each(|(c, chunk)| {
+            chunk.contacts.clear();
+            chunk.shares.clear();
+            let start = c * PARTICLES_PER_CHUNK;
+            for i in start..(start + PARTICLES_PER_CHUNK).min(n) {
+                if !w.particles.is_passive(i) {
+                    particle_contacts(w, i, list, kept, laws, regularisation_length, dt, chunk);
+                }
+            }
+        });
+
+    let next = &mut work.next_history;
+    next.clear();
+    let (mut contacts, mut energy) = totals;
+    for chunk in &work.chunks[..chunks] {
+        for contact in &chunk.contacts {
+            let (i, c) = (contact.particle as usize, &contact.force);
+            contacts += 1;
+            energy += c.energy;
+            touching[i] = true;
+            let p = &mut world.particles;
+            p.force[i] += c.force;
+            p.torque[i] += c.torque;
+            let wall = &mut world.walls[contact.wall as usize];
+            wall.force -= c.force;
+            wall.torque += c.reaction_torque(&wall.reference(), &p.position[i]);
+            let facets = &chunk.shares[contact.shares.clone()];
+            let total: Real = facets.iter().map(|f| f.1).sum();
+            if total > 0.0 {
+                for &(f, share) in facets {
+                    wall.facet_force[f as usize] -= c.force * (share / total);
+                }
+            }
+            if !c.history.is_empty() {
+                next.insert(contact.key, c.history);
+            }
+        }
+    }
+    std::mem::swap(history, next);
+    (contacts, energy)
+}
+
+/// Contacts of particle `i` with every wall, one per coplanar patch of facets, pushed
+/// onto `chunk`.
+#[allow(clippy::too_many_arguments)]
+fn particle_contacts(
+    world: &World,
+    i: usize,
+    list: &NeighbourList,
+    history: &FastMap<WallKey, TangentialHistory>,
+    laws: &ContactLaws,
+    regularisation_length: Real,
+    dt: Real,
+    chunk: &mut WallChunk,
+) {
+    let p = &world.particles;
+    let t = &world.body_types[p.body_type[i] as usize];
+    let radius = t.shape.circumradius();
+    let pose = pose_of(world, i);
+    let merge = match t.shape {
+        Shape::Polyhedron(_) => Merge::Sum,
+        Shape::Sphere(_) => Merge::Deepest,
+    };
+    for (w, wall) in world.walls.iter().enumerate() {
+        let facets = list.facets(i, w);
+        if facets.is_empty() {
+            continue;
+        }
+        chunk.patches.clear();
+        for &f in facets {
+            let tri = wall.facet_world(f as usize);
+            let n = (tri[1] - tri[0]).cross(&(tri[2] - tri[0])).normalize();
+            // Walls are one-sided: a particle whose centroid is behind a facet's plane
+            // has passed it (or the mesh faces the wrong way) and is not pushed back
+            // through from behind, where the half-infinite prism would meet it with
+            // its whole volume at once.
+            if n.dot(&(p.position[i] - tri[0])) < 0.0 {
+                continue;
+            }
+            let key = plane_key(&n, &tri[0], radius);
+            if let Some(g) = facet_geometry(&t.shape, &pose, &tri) {
+                chunk.patches.add(key, f, g, merge);
+            }
+        }
+        let wm = &world.materials[wall.material];
+        let pm = &world.materials[t.material];
+        let e = pair_restitution(pm.restitution, wm.restitution);
+        let table = laws.damping_of(e);
+        let law = LawInputs {
+            stiffness: PairStiffness::particle_wall(pm, t.shape.equivalent_radius(), wm),
+            damping: &table,
+            friction: 0.5 * (pm.friction + wm.friction),
+            regularisation: (regularisation_length * t.shape.equivalent_radius()).powi(3),
+            dt,
+        };
+        let spin = world.angular_velocity(i);
+        for (key, g, facet_shares) in chunk.patches.iter() {
+            if !(g.area > 0.0) || !g.normal.iter().all(|x| x.is_finite()) {
+                continue;
+            }
+            let motion = RelativeMotion {
+                velocity: velocity_at(world, i, &spin, &g.point) - wall.velocity_at(&g.point),
+                spin: spin - wall.angular_velocity,
+                inverse_mass: inverse_mass_at(world, i, &g.point, &g.normal),
+                inertia: t.inertia.min(),
+            };
+            let wall_key = (p.id[i], w as u32, key);
+            let h = history.get(&wall_key).copied().unwrap_or_default();
+            let force = contact_force(g, &motion, &law, h, &p.position[i]);
+            let start = chunk.shares.len();
+            chunk.shares.extend_from_slice(facet_shares);
+            chunk.contacts.push(WallContact {
+                particle: i as u32,
+                wall: w as u32,
+                key: wall_key,
+                force,
+                shares: start..chunk.shares.len(),
+            });
+        }
+    }
+}

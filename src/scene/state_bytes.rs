@@ -1,0 +1,355 @@
+//! The dynamic state of a [`crate::scene::Simulation`] ([`SimState`]) as bytes, and back.
+//!
+//! What is saved is everything that evolves: particles (with this step's forces, which
+//! the next half kick uses, and whether they are frozen), wall poses, velocities and
+//! forces, the tangential contact history, inlet counters, box offsets and random
+//! generators, time, step count, the settling clock and the bed height last measured.
+//! What a scene defines once (materials, shapes, wall meshes and their facet grids) is
+//! not saved: a state is restored into a simulation of the same scene, and a
+//! fingerprint of that scene in the header refuses any other. Restoring and stepping
+//! on gives the same bits as never having saved.
+//!
+//! The format is little-endian, versioned by a magic string; every count is checked
+//! against what is left, so garbage bytes give an error, never a panic or a huge
+//! allocation.
+
+use nalgebra::{Isometry3, Point3, Quaternion, Translation3, UnitQuaternion, Vector3};
+use thiserror::Error;
+
+use super::state::{InletState, SimState, WallState};
+use crate::Real;
+use crate::contact::TangentialHistory;
+use crate::engine::ContactHistory;
+use crate::engine::StepStats;
+use crate::world::Particles;
+
+const MAGIC: &[u8; 8] = b"TALUSST3";
+
+/// Why bytes could not be restored as a state.
+#[derive(Debug, Error, PartialEq)]
+pub enum StateError {
+    /// Not a talus state (or one of another format version).
+    #[error("not a talus state (the bytes do not start with the state header)")]
+    NotAState,
+    /// A state of another scene.
+    #[error("the state belongs to another scene (fingerprint {found:#x}, expected {expected:#x})")]
+    OtherScene {
+        /// The fingerprint in the bytes.
+        found: u64,
+        /// The current scene's.
+        expected: u64,
+    },
+    /// The bytes end early or hold an impossible value.
+    #[error("corrupt state: {0}")]
+    Corrupt(String),
+}
+
+/// Appends values to a byte buffer.
+#[derive(Debug, Default)]
+pub struct StateWriter {
+    bytes: Vec<u8>,
+}
+
+impl StateWriter {
+    /// The bytes written.
+    pub fn into_bytes(self) -> Vec<u8> {
+        self.bytes
+    }
+
+    /// An unsigned integer.
+    pub fn u64(&mut self, x: u64) {
+        self.bytes.extend_from_slice(&x.to_le_bytes());
+    }
+
+    /// A float, bit for bit.
+    pub fn f64(&mut self, x: Real) {
+        self.u64(x.to_bits());
+    }
+
+    /// A vector.
+    pub fn vec3(&mut self, v: &Vector3<Real>) {
+        v.iter().for_each(|x| self.f64(*x));
+    }
+
+    /// A quaternion (w, x, y, z).
+    pub fn quat(&mut self, q: &UnitQuaternion<Real>) {
+        [q.w, q.i, q.j, q.k].iter().for_each(|x| self.f64(*x));
+    }
+
+    /// A length-prefixed byte string.
+    pub fn blob(&mut self, b: &[u8]) {
+        self.u64(b.len() as u64);
+        self.bytes.extend_from_slice(b);
+    }
+}
+
+/// Reads values written by a [`StateWriter`].
+#[derive(Debug)]
+pub struct StateReader<'a> {
+    bytes: &'a [u8],
+    at: usize,
+}
+
+impl<'a> StateReader<'a> {
+    /// A reader at the start of `bytes`.
+    pub fn new(bytes: &'a [u8]) -> Self {
+        StateReader { bytes, at: 0 }
+    }
+
+    fn take(&mut self, n: usize) -> Result<&'a [u8], StateError> {
+        let end = self.at.checked_add(n).filter(|&e| e <= self.bytes.len());
+        let end = end.ok_or_else(|| {
+            StateError::Corrupt(format!(
+                "ends at byte {} of {} needed",
+                self.bytes.len(),
+                self.at + n
+            ))
+        })?;
+        let s = &self.bytes[self.at..end];
+        self.at = end;
+        Ok(s)
+    }
+
+    /// An unsigned integer.
+    pub fn u64(&mut self) -> Result<u64, StateError> {
+        Ok(u64::from_le_bytes(
+            self.take(8)?.try_into().expect("8 bytes"),
+        ))
+    }
+
+    /// A count of items of at least `item_bytes` each, checked against what is left.
+    pub fn count(&mut self, item_bytes: usize) -> Result<usize, StateError> {
+        let n = self.u64()?;
+        let left = (self.bytes.len() - self.at) as u64;
+        if n.saturating_mul(item_bytes.max(1) as u64) > left {
+            return Err(StateError::Corrupt(format!(
+                "a count of {n} at byte {} exceeds the {left} bytes left",
+                self.at - 8
+            )));
+        }
+        Ok(n as usize)
+    }
+
+    /// A float.
+    pub fn f64(&mut self) -> Result<Real, StateError> {
+        Ok(Real::from_bits(self.u64()?))
+    }
+
+    /// A vector.
+    pub fn vec3(&mut self) -> Result<Vector3<Real>, StateError> {
+        Ok(Vector3::new(self.f64()?, self.f64()?, self.f64()?))
+    }
+
+    /// A unit quaternion (stored as written, not renormalised).
+    pub fn quat(&mut self) -> Result<UnitQuaternion<Real>, StateError> {
+        let (w, i, j, k) = (self.f64()?, self.f64()?, self.f64()?, self.f64()?);
+        let q = Quaternion::new(w, i, j, k);
+        if !((q.norm() - 1.0).abs() < 1e-6) {
+            return Err(StateError::Corrupt(format!(
+                "orientation {q:?} is not a unit quaternion"
+            )));
+        }
+        Ok(UnitQuaternion::new_unchecked(q))
+    }
+
+    /// A length-prefixed byte string.
+    pub fn blob(&mut self) -> Result<&'a [u8], StateError> {
+        let n = self.count(1)?;
+        self.take(n)
+    }
+
+    /// Whether every byte was read.
+    pub fn is_done(&self) -> bool {
+        self.at == self.bytes.len()
+    }
+}
+
+fn write_history(w: &mut StateWriter, h: &TangentialHistory) {
+    w.vec3(&h.spring);
+    w.f64(h.stiffness);
+    w.f64(h.twist);
+}
+
+fn read_history(r: &mut StateReader) -> Result<TangentialHistory, StateError> {
+    Ok(TangentialHistory {
+        spring: r.vec3()?,
+        stiffness: r.f64()?,
+        twist: r.f64()?,
+    })
+}
+
+impl SimState {
+    /// Writes the state, headed by the scene's `fingerprint`.
+    pub fn write(&self, fingerprint: u64, w: &mut StateWriter) {
+        w.bytes.extend_from_slice(MAGIC);
+        w.u64(fingerprint);
+        w.f64(self.time);
+        w.f64(self.dt);
+        w.u64(self.steps);
+        w.u64(self.next_id);
+        w.f64(self.quiet_since.unwrap_or(Real::NAN));
+        w.f64(self.bed_height.unwrap_or(Real::NAN));
+        w.u64(self.stats.contacts as u64);
+        w.f64(self.stats.elastic_energy);
+
+        let p = &self.particles;
+        w.u64(p.len() as u64);
+        for i in 0..p.len() {
+            w.u64(p.id[i]);
+            w.u64(p.body_type[i] as u64);
+            w.vec3(&p.position[i].coords);
+            w.quat(&p.orientation[i]);
+            w.vec3(&p.velocity[i]);
+            w.vec3(&p.angular_momentum[i]);
+            w.vec3(&p.force[i]);
+            w.vec3(&p.torque[i]);
+            w.u64(p.frozen[i] as u64);
+        }
+
+        w.u64(self.walls.len() as u64);
+        for wall in &self.walls {
+            w.vec3(&wall.pose.translation.vector);
+            w.quat(&wall.pose.rotation);
+            w.vec3(&wall.velocity);
+            w.vec3(&wall.angular_velocity);
+            w.vec3(&wall.force);
+            w.vec3(&wall.torque);
+            w.u64(wall.facet_force.len() as u64);
+            wall.facet_force.iter().for_each(|f| w.vec3(f));
+        }
+
+        w.u64(self.inlets.len() as u64);
+        for inlet in &self.inlets {
+            w.u64(inlet.inserted as u64);
+            w.u64(inlet.count as u64);
+            w.vec3(&inlet.offset);
+            w.blob(&inlet.rng);
+        }
+
+        let history = &self.history;
+        w.u64(history.pairs.len() as u64);
+        for ((a, b), h) in &history.pairs {
+            w.u64(*a);
+            w.u64(*b);
+            write_history(w, h);
+        }
+        w.u64(history.walls.len() as u64);
+        for ((id, wall, plane), h) in &history.walls {
+            w.u64(*id);
+            w.u64(*wall as u64);
+            plane.iter().for_each(|x| w.u64(*x as u64));
+            write_history(w, h);
+        }
+    }
+
+    /// Reads a state written by [`SimState::write`] for the scene with this
+    /// `fingerprint`, leaving the reader after it (the caller checks
+    /// [`StateReader::is_done`] or reads on). Whether it fits the scene (body types,
+    /// walls, facets, inlets) is checked when it is restored.
+    pub fn read(fingerprint: u64, r: &mut StateReader) -> Result<SimState, StateError> {
+        if r.take(MAGIC.len()).ok() != Some(&MAGIC[..]) {
+            return Err(StateError::NotAState);
+        }
+        let found = r.u64()?;
+        if found != fingerprint {
+            return Err(StateError::OtherScene {
+                found,
+                expected: fingerprint,
+            });
+        }
+        let time = r.f64()?;
+        let dt = r.f64()?;
+        let steps = r.u64()?;
+        let next_id = r.u64()?;
+        let quiet = r.f64()?;
+        let height = r.f64()?;
+        let stats = StepStats {
+            contacts: r.u64()? as usize,
+            elastic_energy: r.f64()?,
+            ..StepStats::default()
+        };
+
+        let n = r.count(8 * 22)?;
+        let mut particles = Particles::default();
+        for _ in 0..n {
+            let id = r.u64()?;
+            let body_type = r.u64()?;
+            let body_type = u32::try_from(body_type).map_err(|_| {
+                StateError::Corrupt(format!("particle {id} has body type {body_type}"))
+            })?;
+            let position = Point3::from(r.vec3()?);
+            let orientation = r.quat()?;
+            particles.push(body_type, position, orientation, id);
+            let i = particles.len() - 1;
+            particles.velocity[i] = r.vec3()?;
+            particles.angular_momentum[i] = r.vec3()?;
+            particles.force[i] = r.vec3()?;
+            particles.torque[i] = r.vec3()?;
+            particles.frozen[i] = match r.u64()? {
+                0 => false,
+                1 => true,
+                x => {
+                    return Err(StateError::Corrupt(format!(
+                        "particle {id} has frozen flag {x}, not 0 or 1"
+                    )));
+                }
+            };
+        }
+
+        let mut walls = Vec::new();
+        for _ in 0..r.count(8 * 20)? {
+            let t = r.vec3()?;
+            let q = r.quat()?;
+            let mut wall = WallState {
+                pose: Isometry3::from_parts(Translation3::from(t), q),
+                velocity: r.vec3()?,
+                angular_velocity: r.vec3()?,
+                force: r.vec3()?,
+                torque: r.vec3()?,
+                facet_force: Vec::new(),
+            };
+            for _ in 0..r.count(24)? {
+                wall.facet_force.push(r.vec3()?);
+            }
+            walls.push(wall);
+        }
+
+        let mut inlets = Vec::new();
+        for _ in 0..r.count(8 * 6)? {
+            inlets.push(InletState {
+                inserted: r.u64()? as usize,
+                count: r.u64()? as usize,
+                offset: r.vec3()?,
+                rng: r.blob()?.to_vec(),
+            });
+        }
+
+        let mut history = ContactHistory::default();
+        for _ in 0..r.count(8 * 7)? {
+            let key = (r.u64()?, r.u64()?);
+            history.pairs.push((key, read_history(r)?));
+        }
+        for _ in 0..r.count(8 * 11)? {
+            let id = r.u64()?;
+            let wall = r.u64()? as u32;
+            let mut plane = [0i64; 4];
+            for x in &mut plane {
+                *x = r.u64()? as i64;
+            }
+            history.walls.push(((id, wall, plane), read_history(r)?));
+        }
+        Ok(SimState {
+            time,
+            dt,
+            steps,
+            next_id,
+            quiet_since: (!quiet.is_nan()).then_some(quiet),
+            bed_height: (!height.is_nan()).then_some(height),
+            stats,
+            particles,
+            walls,
+            inlets,
+            history,
+        })
+    }
+}

@@ -1,0 +1,214 @@
+//! Particle state in flat arrays (structure of arrays): owned particles first, ghost
+//! copies after them.
+
+use std::collections::HashMap;
+
+use nalgebra::{Point3, UnitQuaternion, Vector3};
+
+use crate::Real;
+
+/// Particle state, one entry per particle in every array.
+///
+/// # Owned and ghost particles
+/// The first [`Particles::owned`] entries are the particles this world integrates;
+/// the [`Particles::ghosts`] entries after them are copies of particles owned
+/// elsewhere (another MPI rank's boundary layer). A ghost is felt by the owned
+/// particles it touches and is never integrated; it gets no force of its own, takes
+/// no part in wall contacts, and is left out of every output, energy and saved state.
+/// A ghost is not frozen: frozen means "part of a bed, at rest for good", and an
+/// owned particle may be frozen or not.
+///
+/// # Ids
+/// Every particle has a stable id that survives reordering and keys the contact
+/// history; [`Particles::index_of`] finds the entry of an id. The map is kept by the
+/// methods here: code that writes [`Particles::id`] directly calls
+/// [`Particles::reindex`].
+#[derive(Clone, Debug, Default)]
+pub struct Particles {
+    /// Centroid positions.
+    pub position: Vec<Point3<Real>>,
+    /// Orientations (body frame to world).
+    pub orientation: Vec<UnitQuaternion<Real>>,
+    /// Linear velocities.
+    pub velocity: Vec<Vector3<Real>>,
+    /// Angular momenta in the world frame.
+    pub angular_momentum: Vec<Vector3<Real>>,
+    /// Forces of the current step.
+    pub force: Vec<Vector3<Real>>,
+    /// Torques about the centroid of the current step.
+    pub torque: Vec<Vector3<Real>>,
+    /// Index into [`crate::world::World::body_types`].
+    pub body_type: Vec<u32>,
+    /// Stable identifier (survives reordering; keys the contact history).
+    pub id: Vec<u64>,
+    /// Whether the particle is frozen (see [`Particles::freeze`]): it keeps its pose,
+    /// its velocity and angular momentum are zero, and only particles that are not
+    /// frozen feel its contacts.
+    pub frozen: Vec<bool>,
+    /// Number of ghost copies at the end of the arrays.
+    ghosts: usize,
+    /// Entry of each id.
+    index: HashMap<u64, u32>,
+}
+
+impl Particles {
+    /// Number of particles, ghosts included.
+    pub fn len(&self) -> usize {
+        self.position.len()
+    }
+
+    /// Whether there are none.
+    pub fn is_empty(&self) -> bool {
+        self.position.is_empty()
+    }
+
+    /// Number of owned particles: entries `0..owned()`.
+    pub fn owned(&self) -> usize {
+        self.len() - self.ghosts
+    }
+
+    /// Number of ghost copies: entries `owned()..len()`.
+    pub fn ghosts(&self) -> usize {
+        self.ghosts
+    }
+
+    /// Whether entry `i` is a ghost copy.
+    #[inline]
+    pub fn is_ghost(&self, i: usize) -> bool {
+        i >= self.owned()
+    }
+
+    /// Whether entry `i` is moved by nobody here: frozen, or a ghost.
+    #[inline]
+    pub fn is_passive(&self, i: usize) -> bool {
+        self.frozen[i] || self.is_ghost(i)
+    }
+
+    /// The entry of the particle with `id`, if present.
+    pub fn index_of(&self, id: u64) -> Option<usize> {
+        self.index.get(&id).map(|&i| i as usize)
+    }
+
+    /// Appends an owned particle at rest (before the ghosts, if there are any).
+    pub fn push(
+        &mut self,
+        body_type: u32,
+        position: Point3<Real>,
+        orientation: UnitQuaternion<Real>,
+        id: u64,
+    ) {
+        let at = self.owned();
+        self.insert_at(at, body_type, position, orientation, id);
+        if self.ghosts > 0 {
+            self.reindex();
+        }
+    }
+
+    /// Appends a ghost copy at rest (its state is set by the caller).
+    pub fn push_ghost(
+        &mut self,
+        body_type: u32,
+        position: Point3<Real>,
+        orientation: UnitQuaternion<Real>,
+        id: u64,
+    ) {
+        let at = self.len();
+        self.insert_at(at, body_type, position, orientation, id);
+        self.ghosts += 1;
+    }
+
+    fn insert_at(
+        &mut self,
+        at: usize,
+        body_type: u32,
+        position: Point3<Real>,
+        orientation: UnitQuaternion<Real>,
+        id: u64,
+    ) {
+        self.position.insert(at, position);
+        self.orientation.insert(at, orientation);
+        self.velocity.insert(at, Vector3::zeros());
+        self.angular_momentum.insert(at, Vector3::zeros());
+        self.force.insert(at, Vector3::zeros());
+        self.torque.insert(at, Vector3::zeros());
+        self.body_type.insert(at, body_type);
+        self.id.insert(at, id);
+        self.frozen.insert(at, false);
+        self.index.insert(id, at as u32);
+    }
+
+    /// Removes every ghost copy.
+    pub fn clear_ghosts(&mut self) {
+        let owned = self.owned();
+        for &id in &self.id[owned..] {
+            self.index.remove(&id);
+        }
+        self.truncate(owned);
+        self.ghosts = 0;
+    }
+
+    /// Removes the entries for which `remove` is true, keeping the order of the rest.
+    /// Returns how many were removed.
+    pub fn remove_where(&mut self, mut remove: impl FnMut(usize) -> bool) -> usize {
+        let n = self.len();
+        let keep: Vec<bool> = (0..n).map(|i| !remove(i)).collect();
+        let removed_ghosts = keep[self.owned()..].iter().filter(|k| !**k).count();
+        fn retain<T>(v: &mut Vec<T>, keep: &[bool]) {
+            let mut k = keep.iter();
+            v.retain(|_| *k.next().expect("one flag per entry"));
+        }
+        retain(&mut self.position, &keep);
+        retain(&mut self.orientation, &keep);
+        retain(&mut self.velocity, &keep);
+        retain(&mut self.angular_momentum, &keep);
+        retain(&mut self.force, &keep);
+        retain(&mut self.torque, &keep);
+        retain(&mut self.body_type, &keep);
+        retain(&mut self.id, &keep);
+        retain(&mut self.frozen, &keep);
+        self.ghosts -= removed_ghosts;
+        self.reindex();
+        n - self.len()
+    }
+
+    fn truncate(&mut self, n: usize) {
+        self.position.truncate(n);
+        self.orientation.truncate(n);
+        self.velocity.truncate(n);
+        self.angular_momentum.truncate(n);
+        self.force.truncate(n);
+        self.torque.truncate(n);
+        self.body_type.truncate(n);
+        self.id.truncate(n);
+        self.frozen.truncate(n);
+    }
+
+    /// The owned particles alone (what a saved state holds).
+    pub fn owned_only(&self) -> Particles {
+        let mut p = self.clone();
+        p.clear_ghosts();
+        p
+    }
+
+    /// Rebuilds the id map after [`Particles::id`] was written directly.
+    pub fn reindex(&mut self) {
+        self.index.clear();
+        self.index
+            .extend(self.id.iter().enumerate().map(|(i, &id)| (id, i as u32)));
+    }
+
+    /// Freezes particle `i`: it stops and is no longer integrated; its contacts with
+    /// other frozen particles are skipped and its wall contacts too, while a particle
+    /// that is not frozen still rests on it. What a long packing run uses for the
+    /// buried part of a bed, whose structure no longer changes (see `[bed] freeze`).
+    pub fn freeze(&mut self, i: usize) {
+        self.frozen[i] = true;
+        self.velocity[i] = Vector3::zeros();
+        self.angular_momentum[i] = Vector3::zeros();
+    }
+
+    /// Number of frozen (owned) particles.
+    pub fn frozen_count(&self) -> usize {
+        self.frozen[..self.owned()].iter().filter(|&&f| f).count()
+    }
+}
