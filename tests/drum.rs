@@ -94,9 +94,9 @@ fn run(sim: &mut Simulation, drum: &Drum, from: Real, until: Real) -> Means {
         sim.step();
         if sim.time() > from {
             let dt = sim.dt();
-            let (drive, _, power) = drum.torques(&sim.world());
+            let (drive, _, power) = drum.torques(sim.world());
             m.drive += drive * dt;
-            m.moment += drum.gravity_moment(&sim.world()) * dt;
+            m.moment += drum.gravity_moment(sim.world()) * dt;
             m.power += power * dt;
             span += dt;
         }

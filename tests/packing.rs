@@ -217,7 +217,7 @@ fn an_inlet_feeds_until_the_bed_height_is_reached() {
     let inserted = sim.inlets()[0].inserted;
     assert_eq!(sim.inlets()[0].count, inserted, "the inlet stopped");
     assert!((50..150).contains(&inserted), "{inserted} spheres");
-    let (height, porosity) = bed_figures(&sim.world(), &bed).unwrap();
+    let (height, porosity) = bed_figures(sim.world(), &bed).unwrap();
     println!("{inserted} spheres, bed height {height:.4} m, porosity {porosity:.3}");
     assert!(
         height > target - 0.5 * d && height < target + 2.0 * d,
@@ -346,7 +346,7 @@ fn a_bed_fed_from_above_with_its_buried_part_frozen() {
     for freeze in [true, false] {
         let (sim, frozen_at, bed) = fill_from_above(freeze);
         let inlet = &sim.inlets()[0];
-        let (height, porosity) = bed_figures(&sim.world(), &bed).unwrap();
+        let (height, porosity) = bed_figures(sim.world(), &bed).unwrap();
         let p = &sim.world().particles;
         let frozen = p.frozen_count();
         println!(

@@ -46,7 +46,7 @@ fn two_hundred_pellets_at_n_4_5_settle_into_a_wall_ordered_bed() {
         assert!(x.x.hypot(x.y) < 0.0125 && x.z > 0.0, "{x}");
     }
 
-    let packing = analyse(&sim.world(), scene.bed.as_ref().unwrap()).unwrap();
+    let packing = analyse(sim.world(), scene.bed.as_ref().unwrap()).unwrap();
     let d = 5.5e-3;
     let radial = &packing.radial;
     let profile: Vec<(f64, f64)> = radial

@@ -91,7 +91,7 @@ fn elastic_gas_of_dodecahedra_conserves_energy() {
 /// Pairs of particles whose bounding spheres overlap and whose shapes intersect.
 fn touching(sim: &Simulation) -> BTreeSet<(usize, usize)> {
     use talus::geometry::gjk::{GjkResult, gjk};
-    let w = &sim.world();
+    let w = sim.world();
     let p = &w.particles;
     let shape = w.body_types[0].shape.as_polyhedron().unwrap();
     let r = shape.circumradius();

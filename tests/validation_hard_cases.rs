@@ -139,7 +139,7 @@ count = 150
 "#
     );
     let sim = settle(&text, [0.0; 3], [0.05, 0.05, 0.2], 3.0, true);
-    let w = &sim.world();
+    let w = sim.world();
     let p = &w.particles;
     let large = w.body_types[p.body_type[0] as usize]
         .shape

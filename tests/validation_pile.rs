@@ -64,7 +64,7 @@ spacing = 0.0106
 count = 1000
 "#;
     let energy = |sim: &Simulation| {
-        let w = &sim.world();
+        let w = sim.world();
         let p = &w.particles;
         let potential: f64 = (0..p.len())
             .map(|i| w.body_types[p.body_type[i] as usize].mass * 9.81 * p.position[i].z)

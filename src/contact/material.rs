@@ -95,8 +95,9 @@ impl Material {
 
 /// Stiffness factors of a contact between two bodies, per unit contact area: the
 /// normal `κ = E₁/R₁ + E₂/R₂` and the tangential `G₁/R₁ + G₂/R₂`, with `R` the
-/// volume-equivalent radii (primary seed, eqs. 13 and 19). A wall counts as a body of
-/// infinite radius.
+/// volume-equivalent radii (Xu et al., "Large-Scale Multiple-GPU-based DEM
+/// Simulation of Polyhedral Particle Systems", eqs. 13 and 19). A wall counts as a
+/// body of infinite radius.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PairStiffness {
     /// Normal factor κ, Pa/m.
@@ -167,7 +168,7 @@ mod tests {
         let p = PairStiffness::particles(&s, 0.01, &s, 0.02);
         assert!((p.normal - (2e11 / 0.01 + 2e11 / 0.02)).abs() < 1.0);
         assert!((p.tangential - s.shear_modulus() * (1.0 / 0.01 + 1.0 / 0.02)).abs() < 1.0);
-        // A wall of the same material acts as one particle term (the seed's R → ∞);
+        // A wall of the same material acts as one particle term (Xu et al.'s R → ∞);
         // a rigid wall doubles it.
         let w = PairStiffness::particle_wall(&s, 0.01, &s);
         assert!((w.normal - 2e11 / 0.01).abs() < 1.0);

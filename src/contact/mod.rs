@@ -10,13 +10,14 @@
 //! The elastic part derives from the potential `U(V) = ¾ κ V^{4/3}` of the overlap
 //! volume, `κ = E₁/R₁ + E₂/R₂` (Young's moduli over volume-equivalent radii). Since the
 //! contact-area vector `A_n n` is exactly `∂V/∂x` (see [`crate::geometry::overlap`]),
-//! the force `F = U'(V) A_n n = κ A_n V^{1/3} n` is the primary seed's eq. 12–13 and
+//! the force `F = U'(V) A_n n = κ A_n V^{1/3} n` is eq. 12–13 of Xu et al.,
+//! "Large-Scale Multiple-GPU-based DEM Simulation of Polyhedral Particle Systems", and
 //! conserves energy exactly: the work of the elastic force around any closed path is
 //! zero.
 //!
 //! # Normal damping calibrated to the restitution coefficient
 //!
-//! The seed's damping (eq. 15) is the linear spring–dashpot's; printed with
+//! Xu et al.'s damping (eq. 15) is the linear spring–dashpot's; printed with
 //! `2 ln(e)` it is negative, and taken literally it would feed energy in. The volume
 //! law is not linear in the depth δ: with `V ∝ δ^a` near contact (a = 1 for a flat face
 //! on a face, 2 for an edge, 3 for a vertex), the force grows as `δ^p`, `p = 4a/3 − 1`

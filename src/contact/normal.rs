@@ -59,7 +59,7 @@ pub struct NormalForce {
 ///
 /// so the force is `κ A V / V₀^{2/3}` (linear in δ for a flat contact, with the finite
 /// stiffness `κ A² / V₀^{2/3}`), still the gradient of a potential of `V`, and equal
-/// to the seed's law above `V₀`.
+/// to the volume law of Xu et al. above `V₀`.
 pub fn normal_force(c: &NormalContact, damping: &DampingTable) -> NormalForce {
     let volume = c.volume.max(0.0);
     let v0 = c.regularisation.max(0.0);

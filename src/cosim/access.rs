@@ -132,11 +132,11 @@ impl Component {
             Role::DriveTorque => self.drum_means().0,
             Role::DrivePower => self.drum_means().1,
             Role::AngleOfRepose => match (sim, &self.scene.drum) {
-                (Some(s), Some(d)) => d.surface(&s.world()).map_or(0.0, |f| f.slope.atan().abs()),
+                (Some(s), Some(d)) => d.surface(s.world()).map_or(0.0, |f| f.slope.atan().abs()),
                 _ => 0.0,
             },
             Role::BedHeight | Role::BedPorosity => match (sim, &self.scene.bed) {
-                (Some(s), Some(bed)) => crate::analysis::packing::bed_figures(&s.world(), bed)
+                (Some(s), Some(bed)) => crate::analysis::packing::bed_figures(s.world(), bed)
                     .map_or(0.0, |(h, e)| if role == Role::BedHeight { h } else { e }),
                 _ => 0.0,
             },
@@ -157,7 +157,7 @@ impl Component {
         let mut power = 0.0;
         for &w in &drum.walls {
             let m = &self.means[w];
-            torque -= drum.axial_torque(&sim.world(), w, &m.force, &m.torque);
+            torque -= drum.axial_torque(sim.world(), w, &m.force, &m.torque);
             power += m.power;
         }
         (torque, power)

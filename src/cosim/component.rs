@@ -434,7 +434,7 @@ impl Component {
         )?;
         if let (Some(out), Some(sim)) = (&mut self.output, &self.sim) {
             out.record(sim.world(), 0.0, sim.stats().contacts, true)?;
-            out.finish(&sim.world())?;
+            out.finish(sim.world())?;
         }
         self.output = None;
         self.mode = Mode::Terminated;

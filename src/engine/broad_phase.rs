@@ -5,7 +5,7 @@
 //! particle, per-cell counts, an exclusive prefix sum to cell starts, a scatter), and
 //! the candidate pairs are written to one flat array: a first pass counts each
 //! particle's pairs, a prefix sum turns the counts into offsets, and a second pass
-//! writes every particle's pairs into its own slice (the primary seed's contact-pair
+//! writes every particle's pairs into its own slice (the contact-pair
 //! parallelism). Both passes are data-parallel over particles and the output order
 //! does not depend on the number of threads.
 //!

@@ -136,8 +136,8 @@ pub fn dodecahedron(circumradius: Real) -> Result<ConvexPolyhedron, GeometryErro
 }
 
 /// Triangle mesh of an `n`-gon prism along z: `2n + 2` vertices and `4n` triangles,
-/// the caps fanned about their centres (for `n = 20`, the primary seed's cylinder of
-/// 42 vertices and 80 triangles). The polygon is inscribed in the circle of
+/// the caps fanned about their centres (for `n = 20`, the pellet of Xu et al.'s
+/// multiple-GPU polyhedral DEM: 42 vertices and 80 triangles). The polygon is inscribed in the circle of
 /// diameter `diameter`.
 pub fn prism_mesh(sides: usize, diameter: Real, length: Real) -> Result<TriMesh, GeometryError> {
     positive("diameter", diameter)?;

@@ -34,7 +34,7 @@ pub enum ShapeSpec {
     },
     /// An n-gon prism "cylinder" along z.
     Prism {
-        /// Number of sides (20 for the primary seed's pellet).
+        /// Number of sides (20 for the pellet of Xu et al.'s packed bed).
         sides: usize,
         /// Diameter of the circumscribed circle.
         diameter: Real,

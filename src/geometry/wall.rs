@@ -15,8 +15,8 @@
 //! push a particle off its edge, as a potential must.)
 //!
 //! The overlap polygon of the facet with the particle's cross-section in the facet
-//! plane — the seed's Sutherland–Hodgman overlap area — comes out as the top face of
-//! `P ∩ Q`.
+//! plane — the Sutherland–Hodgman overlap area of Xu et al.'s multiple-GPU
+//! polyhedral DEM — comes out as the top face of `P ∩ Q`.
 //!
 //! The engine groups the facets a particle touches into coplanar patches and applies
 //! the contact law to each patch's sums, sharing the force among the facets in

@@ -89,8 +89,8 @@ impl Simulation {
             freeze: scene.spec.bed.as_ref().and_then(|b| b.freeze.clone()),
             bed_height: None,
         };
-        sim.insert();
         sim.backend.world_changed(&sim.world);
+        sim.insert();
         sim.initialise();
         sim
     }

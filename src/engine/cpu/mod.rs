@@ -25,7 +25,7 @@ use std::ops::Range;
 
 use self::contact_state::ContactState;
 use self::forces::ContactForce;
-use self::walls::WallWork;
+use self::walls::{WallInputs, WallWork};
 use super::backend::{Backend, ContactHistory};
 use super::laws::ContactLaws;
 use super::neighbours::NeighbourList;
@@ -106,12 +106,15 @@ impl CpuBackend {
         });
         let pair_contacts = totals.0;
         let (count, energy) = times.time(Stage::WallContacts, || {
-            walls::wall_contacts(
-                world,
+            let inputs = WallInputs {
                 list,
                 laws,
-                params.regularisation_length,
+                regularisation_length: params.regularisation_length,
                 dt,
+            };
+            walls::wall_contacts(
+                world,
+                inputs,
                 &mut contacts.wall_history,
                 &mut work.walls,
                 &mut work.touching,

@@ -49,6 +49,16 @@ pub(super) struct WallChunk {
     patches: PatchSet,
 }
 
+/// What the wall stage reads besides the world.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct WallInputs<'a> {
+    pub list: &'a NeighbourList,
+    pub laws: &'a ContactLaws,
+    /// Relative to the particle's equivalent radius (see [`crate::engine::StepParams`]).
+    pub regularisation_length: Real,
+    pub dt: Real,
+}
+
 /// The stage's buffers.
 #[derive(Clone, Debug, Default)]
 pub(super) struct WallWork {
@@ -63,10 +73,7 @@ pub(super) struct WallWork {
 /// (the pairs' figures: the energy is summed on in the same order as ever).
 pub(super) fn wall_contacts(
     world: &mut World,
-    list: &NeighbourList,
-    laws: &ContactLaws,
-    regularisation_length: Real,
-    dt: Real,
+    inputs: WallInputs,
     history: &mut FastMap<WallKey, TangentialHistory>,
     work: &mut WallWork,
     touching: &mut [bool],
@@ -95,7 +102,7 @@ pub(super) fn wall_contacts(
             let start = c * PARTICLES_PER_CHUNK;
             for i in start..(start + PARTICLES_PER_CHUNK).min(n) {
                 if !w.particles.is_passive(i) {
-                    particle_contacts(w, i, list, kept, laws, regularisation_length, dt, chunk);
+                    particle_contacts(w, i, &inputs, kept, chunk);
                 }
             }
         });
@@ -133,17 +140,19 @@ pub(super) fn wall_contacts(
 
 /// Contacts of particle `i` with every wall, one per coplanar patch of facets, pushed
 /// onto `chunk`.
-#[allow(clippy::too_many_arguments)]
 fn particle_contacts(
     world: &World,
     i: usize,
-    list: &NeighbourList,
+    inputs: &WallInputs,
     history: &FastMap<WallKey, TangentialHistory>,
-    laws: &ContactLaws,
-    regularisation_length: Real,
-    dt: Real,
     chunk: &mut WallChunk,
 ) {
+    let WallInputs {
+        list,
+        laws,
+        regularisation_length,
+        dt,
+    } = *inputs;
     let p = &world.particles;
     let t = &world.body_types[p.body_type[i] as usize];
     let radius = t.shape.circumradius();

@@ -14,8 +14,9 @@
 //!   normal force along `S` therefore derives from a potential of the overlap volume
 //!   (Feng's energy-conserving framework), and `|S|` is the projected contact area.
 //!
-//! We chose this over the primary seed's dual-space incremental quickhull because it
-//! needs no point strictly inside the intersection (the polar dual does, and finding
+//! We chose this over the dual-space incremental quickhull of Xu et al.,
+//! "Large-Scale Multiple-GPU-based DEM Simulation of Polyhedral Particle Systems",
+//! because it needs no point strictly inside the intersection (the polar dual does, and finding
 //! one for a tiny overlap is itself a linear program), builds its combinatorial state
 //! from sign tests alone rather than maintaining it through round-off (a hull's
 //! horizon can be corrupted), allocates nothing per pair (the scratch buffers are

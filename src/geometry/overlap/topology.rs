@@ -231,7 +231,12 @@ impl Topology {
     /// Stores `labels` sorted by key, renumbers the loops, and starts each loop at its
     /// least vertex.
     fn canonicalise(&mut self, labels: &[VertexLabel]) {
-        let mut order: Vec<u8> = (0..labels.len() as u8).collect();
+        // A fixed array: a renewal allocates nothing.
+        let mut all = [0u8; MAX_VERTICES];
+        let order = &mut all[..labels.len()];
+        for (k, o) in order.iter_mut().enumerate() {
+            *o = k as u8;
+        }
         order.sort_unstable_by_key(|&k| labels[k as usize].key());
         let mut rank = [0u8; MAX_VERTICES];
         for (new, &old) in order.iter().enumerate() {

@@ -1,0 +1,359 @@
+//! The backend seam: ghost copies give the owned particles the forces of the whole
+//! world, removed particles leave the others' contact history as it was, and every
+//! change the host makes reaches the backend through its sync calls.
+
+use std::ops::{ControlFlow, Range};
+use std::path::Path;
+use std::sync::{Arc, Mutex};
+
+use talus::Real;
+use talus::engine::{Backend, ContactHistory, CpuBackend, StageTimes, StepParams, StepStats};
+use talus::scene::{Scene, Simulation};
+use talus::world::{Particles, World};
+
+/// Four layers of dodecahedra, randomly turned and close enough to overlap, on the
+/// floor of a box.
+const BOX: &str = r#"
+[simulation]
+dt = 1e-5
+end_time = 1.0
+gravity = [0.0, 0.0, -9.81]
+seed = 5
+
+[contact]
+regularisation = 0.2
+
+[materials.pla]
+density = 1500.0
+young = 1e6
+poisson = 0.1
+restitution = 0.3
+friction = 0.5
+
+[shapes.dodecahedron]
+kind = "platonic"
+solid = "dodecahedron"
+circumradius = 0.005
+
+[[wall]]
+name = "box"
+material = "pla"
+geometry = { kind = "box", min = [-0.001, -0.001, 0.0], max = [0.048, 0.048, 0.1], open_top = true }
+
+[[particles]]
+kind = "lattice"
+shape = "dodecahedron"
+material = "pla"
+min = [0.0, 0.0, -0.0004]
+max = [0.0472, 0.0472, 0.038]
+spacing = 0.00925
+velocity = [0.0, 0.0, -0.1]
+"#;
+
+fn world_of(text: &str) -> World {
+    Scene::parse(text, Path::new("box.toml"))
+        .expect("valid scene")
+        .world
+}
+
+/// `world` with its particles `0..owned` kept as owned and the rest as ghosts.
+fn split(world: &World, owned: usize) -> World {
+    let p = &world.particles;
+    let mut q = Particles::default();
+    for i in 0..p.len() {
+        if i < owned {
+            q.push(p.body_type[i], p.position[i], p.orientation[i], p.id[i]);
+        } else {
+            q.push_ghost(p.body_type[i], p.position[i], p.orientation[i], p.id[i]);
+        }
+        let k = q.len() - 1;
+        q.velocity[k] = p.velocity[i];
+        q.angular_momentum[k] = p.angular_momentum[i];
+    }
+    World {
+        particles: q,
+        ..world.clone()
+    }
+}
+
+#[test]
+fn ghosts_give_the_owned_half_the_forces_of_the_whole_box() {
+    let dt = 1e-5;
+    let mut whole = world_of(BOX);
+    let n = whole.particles.len();
+    assert_eq!(n, 100, "4 layers of 25");
+    // The lattice fills layer by layer from the floor: the first half of the
+    // particles is the lower half of the box, and the ghosts of the upper half come
+    // after every owned particle, as they do in the whole box.
+    let owned = n / 2;
+    let mut half = split(&whole, owned);
+    assert_eq!(half.particles.owned(), owned);
+    assert_eq!(half.particles.ghosts(), n - owned);
+    assert!(half.particles.is_ghost(owned) && !half.particles.is_ghost(owned - 1));
+    assert_eq!(
+        half.particles.index_of(whole.particles.id[owned]),
+        Some(owned)
+    );
+
+    let mut a = CpuBackend::new(StepParams::default());
+    let mut b = CpuBackend::new(StepParams::default());
+    a.initialise(&mut whole, dt);
+    b.initialise(&mut half, dt);
+    let touching_ghost = (0..owned).filter(|&i| {
+        b.neighbours()
+            .incident(i)
+            .iter()
+            .any(|&k| b.neighbours().pairs()[k as usize][1] as usize >= owned)
+    });
+    assert!(
+        touching_ghost.count() >= 10,
+        "the lower half has candidates in the upper half"
+    );
+    assert!(a.stats().pair_contacts > 50, "{:?}", a.stats());
+    assert!(
+        a.stats().contacts > a.stats().pair_contacts,
+        "wall contacts too"
+    );
+    // The ghosts matter: without them the lower half has fewer contacts and other
+    // forces.
+    let mut lower = World {
+        particles: half.particles.owned_only(),
+        ..half.clone()
+    };
+    let mut c = CpuBackend::new(StepParams::default());
+    c.initialise(&mut lower, dt);
+    assert!(
+        c.stats().pair_contacts + 5 <= b.stats().pair_contacts,
+        "{} pair contacts without ghosts, {} with",
+        c.stats().pair_contacts,
+        b.stats().pair_contacts
+    );
+    let changed = (0..owned)
+        .filter(|&i| lower.particles.force[i] != whole.particles.force[i])
+        .count();
+    assert!(changed >= 5, "{changed} forces change without the ghosts");
+    for i in 0..owned {
+        assert_eq!(
+            half.particles.force[i], whole.particles.force[i],
+            "force of {i}"
+        );
+        assert_eq!(
+            half.particles.torque[i], whole.particles.torque[i],
+            "torque of {i}"
+        );
+    }
+    for i in owned..n {
+        assert_eq!(
+            half.particles.force[i],
+            nalgebra::Vector3::zeros(),
+            "ghost {i}"
+        );
+    }
+    // Only the owned half touches the floor: the wall forces are the whole box's.
+    assert_eq!(half.walls[0].force, whole.walls[0].force);
+    assert_eq!(half.walls[0].facet_force, whole.walls[0].facet_force);
+
+    // A step moves the owned particles as in the whole box, and never a ghost.
+    let ghost_position = half.particles.position[owned];
+    a.step(&mut whole, dt);
+    b.step(&mut half, dt);
+    for i in 0..owned {
+        assert_eq!(
+            half.particles.position[i], whole.particles.position[i],
+            "{i}"
+        );
+        assert_eq!(
+            half.particles.orientation[i],
+            whole.particles.orientation[i]
+        );
+    }
+    assert_eq!(half.particles.position[owned], ghost_position);
+    assert_ne!(whole.particles.position[owned], ghost_position);
+    assert_eq!(b.stats().integrated, owned);
+
+    // Ghosts are in no figure of the world.
+    let owned_only = half.particles.owned_only();
+    assert_eq!((owned_only.len(), owned_only.ghosts()), (owned, 0));
+    let moving = World {
+        particles: owned_only,
+        ..half.clone()
+    };
+    assert_eq!(half.kinetic_energy(), moving.kinetic_energy());
+    assert_eq!(half.max_speed(), moving.max_speed());
+    half.particles.clear_ghosts();
+    assert_eq!(half.particles.len(), owned);
+    assert_eq!(half.particles.index_of(whole.particles.id[owned]), None);
+}
+
+#[test]
+fn removing_a_particle_keeps_the_others_history() {
+    let scene = Scene::parse(BOX, Path::new("box.toml")).unwrap();
+    let mut sim = Simulation::new(&scene);
+    let _ = sim.advance_to(2e-3, |_, _| ControlFlow::<()>::Continue(()));
+    let gone = sim.world().particles.id[30];
+    // The same world and history without the particle, restored into a fresh run.
+    let mut state = sim.snapshot();
+    let i = state.particles.index_of(gone).unwrap();
+    state.particles.remove_where(|k| k == i);
+    state
+        .history
+        .pairs
+        .retain(|((a, b), _)| *a != gone && *b != gone);
+    state.history.walls.retain(|((id, _, _), _)| *id != gone);
+    assert!(!state.history.pairs.is_empty());
+    let mut restored = Simulation::new(&scene);
+    restored.restore(&state).unwrap();
+
+    assert_eq!(sim.remove_particles(|w, k| w.particles.id[k] == gone), 1);
+    assert_eq!(sim.world().particles.index_of(gone), None);
+    for s in [&mut sim, &mut restored] {
+        let _ = s.advance_to(4e-3, |_, _| ControlFlow::<()>::Continue(()));
+    }
+    let (a, b) = (&sim.world().particles, &restored.world().particles);
+    assert_eq!(a.id, b.id);
+    assert_eq!(a.position, b.position);
+    assert_eq!(a.velocity, b.velocity);
+    assert_eq!(a.angular_momentum, b.angular_momentum);
+    assert_eq!(
+        sim.backend().contact_history(),
+        restored.backend().contact_history()
+    );
+}
+
+/// The sync calls a backend received, in order.
+type Calls = Arc<Mutex<Vec<String>>>;
+
+/// A CPU backend that records the host's sync calls, and checks at every step that
+/// the host world holds what the calls told it: the particle ids it was told of.
+#[derive(Debug)]
+struct Recording {
+    inner: CpuBackend,
+    ids: Vec<u64>,
+    calls: Calls,
+}
+
+impl Recording {
+    fn log(&self, call: String) {
+        self.calls.lock().unwrap().push(call);
+    }
+}
+
+impl Backend for Recording {
+    fn name(&self) -> &'static str {
+        "recording"
+    }
+    fn params(&self) -> &StepParams {
+        self.inner.params()
+    }
+    fn set_params(&mut self, params: StepParams) {
+        self.inner.set_params(params)
+    }
+    fn initialise(&mut self, world: &mut World, dt: Real) {
+        assert_eq!(
+            world.particles.id, self.ids,
+            "a change the backend was not told of"
+        );
+        self.inner.initialise(world, dt)
+    }
+    fn step(&mut self, world: &mut World, dt: Real) {
+        assert_eq!(
+            world.particles.id, self.ids,
+            "a change the backend was not told of"
+        );
+        self.inner.step(world, dt)
+    }
+    fn stats(&self) -> &StepStats {
+        self.inner.stats()
+    }
+    fn stage_times(&self) -> &StageTimes {
+        self.inner.stage_times()
+    }
+    fn touching(&self) -> &[bool] {
+        self.inner.touching()
+    }
+    fn particles_added(&mut self, world: &World, added: Range<usize>) {
+        assert_eq!(added.start, self.ids.len());
+        self.ids
+            .extend_from_slice(&world.particles.id[added.clone()]);
+        self.log(format!("added {added:?}"));
+        self.inner.particles_added(world, added)
+    }
+    fn particles_frozen(&mut self, world: &World, frozen: &[usize]) {
+        assert!(frozen.iter().all(|&i| world.particles.frozen[i]));
+        self.log(format!("frozen {}", frozen.len()));
+        self.inner.particles_frozen(world, frozen)
+    }
+    fn particles_removed(&mut self, world: &World) {
+        self.ids.clone_from(&world.particles.id);
+        self.log("removed".into());
+        self.inner.particles_removed(world)
+    }
+    fn velocities_set(&mut self, world: &World) {
+        self.log("velocities".into());
+        self.inner.velocities_set(world)
+    }
+    fn walls_moved(&mut self, world: &World) {
+        self.log("walls".into());
+        self.inner.walls_moved(world)
+    }
+    fn world_changed(&mut self, world: &World) {
+        self.ids.clone_from(&world.particles.id);
+        self.log("world".into());
+        self.inner.world_changed(world)
+    }
+    fn contact_history(&self) -> ContactHistory {
+        self.inner.contact_history()
+    }
+    fn restore(&mut self, world: &World, history: ContactHistory, stats: StepStats) {
+        self.ids.clone_from(&world.particles.id);
+        self.log("restore".into());
+        self.inner.restore(world, history, stats)
+    }
+    fn sync_to_host(&mut self, world: &mut World) {
+        self.inner.sync_to_host(world)
+    }
+}
+
+#[test]
+fn every_change_of_the_host_reaches_the_backend() {
+    // The box fed by an inlet: particles are added between steps.
+    let text = BOX.replace(
+        "[[particles]]",
+        "[[inlet]]\nshape = \"dodecahedron\"\nmaterial = \"pla\"\nmin = [0.0, 0.0, 0.05]\n\
+         max = [0.046, 0.046, 0.09]\nrate = 5000.0\ncount = 10\n\n[[particles]]",
+    );
+    let scene = Scene::parse(&text, Path::new("box.toml")).unwrap();
+    let calls = Calls::default();
+    let backend = Recording {
+        inner: CpuBackend::new(StepParams {
+            regularisation_length: scene.spec.contact.regularisation,
+            skin: scene.spec.contact.skin,
+        }),
+        ids: Vec::new(),
+        calls: calls.clone(),
+    };
+    let mut recorded = Simulation::with_backend(&scene, Box::new(backend));
+    let mut plain = Simulation::new(&scene);
+    let state = plain.snapshot();
+    for sim in [&mut recorded, &mut plain] {
+        let _ = sim.advance_to(3e-3, |_, _| ControlFlow::<()>::Continue(()));
+        sim.move_walls(|walls| walls[0].velocity.x = 0.01);
+        sim.damp_velocities(0.5);
+        let _ = sim.advance_to(4e-3, |_, _| ControlFlow::<()>::Continue(()));
+        sim.remove_particles(|_, k| k == 3);
+        sim.restore(&state).unwrap();
+        let _ = sim.advance_to(1e-3, |_, _| ControlFlow::<()>::Continue(()));
+    }
+    // The recording backend computes what the CPU backend does.
+    assert_eq!(
+        recorded.world().particles.position,
+        plain.world().particles.position
+    );
+    let calls = calls.lock().unwrap().clone();
+    let added = calls.iter().filter(|c| c.starts_with("added")).count();
+    // The inlet inserts 10 particles by 2 ms, once after the restore too (1 ms).
+    assert!(added >= 6, "{calls:?}");
+    for call in ["walls", "velocities", "removed", "restore"] {
+        assert!(calls.iter().any(|c| c == call), "no {call} call: {calls:?}");
+    }
+}
