@@ -25,6 +25,7 @@ pub(super) struct ContactGeometry {
 }
 
 /// The pose of particle `k`.
+#[inline]
 pub(super) fn pose_of(world: &World, k: usize) -> Isometry3<Real> {
     let p = &world.particles;
     Isometry3::from_parts(p.position[k].coords.into(), p.orientation[k])
@@ -32,6 +33,7 @@ pub(super) fn pose_of(world: &World, k: usize) -> Isometry3<Real> {
 
 /// Contact geometry of particles `i` and `j` in world coordinates (normal i → j);
 /// `plan` is the pair's kept overlap plan.
+#[inline]
 pub(super) fn pair_geometry(
     world: &World,
     i: usize,
@@ -92,6 +94,7 @@ pub(super) fn pair_geometry(
 
 /// Contact geometry of a particle of `shape` at `pose` with the wall facet `tri`
 /// (world coordinates), normal out of the wall.
+#[inline]
 pub(super) fn facet_geometry(
     shape: &Shape,
     pose: &Isometry3<Real>,

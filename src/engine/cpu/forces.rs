@@ -27,6 +27,7 @@ pub(super) struct ContactForce {
 impl ContactForce {
     /// Torque on body 1 about `x1`, given body 2's centroid `x2`: what keeps the
     /// pair's angular momentum.
+    #[inline]
     pub(super) fn reaction_torque(&self, x1: &Point3<Real>, x2: &Point3<Real>) -> Vector3<Real> {
         -(self.torque + (x2 - x1).cross(&self.force))
     }
@@ -58,6 +59,7 @@ pub(super) struct LawInputs<'a> {
 
 /// Inverse of the effective mass of particle `i` at `point` along `n`: the lever
 /// `r × n` taken into the body frame, where the inertia is diagonal.
+#[inline]
 pub(super) fn inverse_mass_at(
     world: &World,
     i: usize,
@@ -71,6 +73,7 @@ pub(super) fn inverse_mass_at(
 }
 
 /// Velocity of particle `i`'s material at `point`, given its angular velocity.
+#[inline]
 pub(super) fn velocity_at(
     world: &World,
     i: usize,
@@ -81,6 +84,7 @@ pub(super) fn velocity_at(
 }
 
 /// Normal and tangential force on body 2 of a contact whose centroid is `centre`.
+#[inline]
 pub(super) fn contact_force(
     g: &ContactGeometry,
     motion: &RelativeMotion,
@@ -160,6 +164,7 @@ pub(super) fn contact_force(
 }
 
 /// The force on particle `j` of its contact with particle `i` of geometry `g`.
+#[inline]
 pub(super) fn pair_force(
     world: &World,
     i: usize,

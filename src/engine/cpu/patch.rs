@@ -20,6 +20,7 @@ pub(super) enum Merge {
 /// The plane key of a facet with unit normal `n` through `point`, for a particle of
 /// bounding radius `radius`: facets sharing a plane (to 1e-9 in the normal and 1e-9
 /// radii in offset) share a key.
+#[inline]
 pub(super) fn plane_key(n: &Vector3<Real>, point: &Point3<Real>, radius: Real) -> [i64; 4] {
     [
         (n.x * 1e9).round() as i64,
@@ -47,6 +48,7 @@ impl PatchSet {
     }
 
     /// Adds facet `f`'s contact `g` to the patch of plane `key`.
+    #[inline]
     pub(super) fn add(&mut self, key: [i64; 4], f: u32, g: ContactGeometry, merge: Merge) {
         let Some(k) = self.patches.iter().position(|(pk, _)| *pk == key) else {
             let k = self.patches.len();
