@@ -370,3 +370,73 @@ fn the_output_dir_parameter_writes_the_run_files_while_stepping() {
     assert!(target.join("particles.pvd").is_file());
     assert!(target.join("walls.pvd").is_file());
 }
+
+/// The simulation's whole state as bytes.
+fn sim_bytes(c: &Component) -> Vec<u8> {
+    let mut w = talus::scene::StateWriter::default();
+    c.simulation().unwrap().write_state(0, &mut w);
+    w.into_bytes()
+}
+
+/// Beads falling onto a floor of a material so stiff that its contact stiffness
+/// overflows: the first contact makes the forces infinite.
+const OVERFLOWING: &str = r#"
+[simulation]
+dt = 1e-5
+end_time = 1.0
+gravity = [0.0, 0.0, -9.81]
+
+[materials.stiff]
+density = 2500.0
+young = 1.5e308
+poisson = 0.3
+restitution = 0.5
+
+[shapes.bead]
+kind = "sphere"
+radius = 0.004
+
+[[wall]]
+name = "floor"
+material = "stiff"
+geometry = { kind = "plane", centre = [0.0, 0.0, 0.0], normal = [0.0, 0.0, 1.0], size = 0.1 }
+
+[[particles]]
+kind = "lattice"
+shape = "bead"
+material = "stiff"
+min = [-0.02, -0.02, 0.01]
+max = [0.02, 0.02, 0.02]
+"#;
+
+#[test]
+fn a_step_that_diverges_is_rolled_back_to_the_bits_before_it() {
+    let dir = tempdir("diverging");
+    std::fs::write(dir.join("scene.toml"), OVERFLOWING).unwrap();
+    let mut c = Component::instantiate(&dir, "scene.toml").unwrap();
+    c.enter_initialization_mode(0.0).unwrap();
+    c.exit_initialization_mode().unwrap();
+    c.do_step(0.0, 0.01).unwrap();
+    let floor = |c: &Component| -> Vec<f64> {
+        ["floor.force", "floor.force_end", "kinetic_energy", "time"]
+            .iter()
+            .flat_map(|n| vector(c, n))
+            .collect()
+    };
+    let (before, outputs_before) = (sim_bytes(&c), floor(&c));
+    // The beads reach the floor after about 45 ms.
+    for _ in 0..2 {
+        let err = c.do_step(0.01, 0.1).unwrap_err();
+        assert!(matches!(err, CosimError::Diverged(_)), "{err}");
+        assert_eq!(c.mode(), Mode::Step);
+        assert_eq!(time(&c), 0.01);
+        assert!(
+            sim_bytes(&c) == before,
+            "the state is the one before the step"
+        );
+        assert_eq!(bits(&floor(&c)), bits(&outputs_before));
+    }
+    // Shorter steps that stop short of the floor still go on from there.
+    c.do_step(0.01, 0.01).unwrap();
+    assert_eq!(time(&c), 0.02);
+}
