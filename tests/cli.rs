@@ -164,6 +164,18 @@ fn bench_runs_on_part_of_the_shipped_settled_bed() {
     let rows: Vec<&str> = out.lines().filter(|l| l.starts_with('(')).collect();
     assert_eq!(rows.len(), 1, "{out}");
     assert!(rows[0].starts_with("(a)") && rows[0].split_whitespace().nth(5) == Some("2"));
+    // Below the row, each stage's share of the timed steps; together the whole step.
+    let stages = out
+        .lines()
+        .find_map(|l| l.trim().strip_prefix("stages: "))
+        .unwrap_or_else(|| panic!("no stage line: {out}"));
+    let shares: Vec<f64> = stages
+        .split(", ")
+        .map(|s| s.rsplit(' ').nth(1).unwrap().parse().unwrap())
+        .collect();
+    assert_eq!(shares.len(), 7, "{stages}");
+    assert!(stages.starts_with("integrate") && stages.contains("pair_contacts"));
+    assert!((shares.iter().sum::<f64>() - 100.0).abs() < 0.5, "{stages}");
     // A scene that does not exist is named in the error.
     let (ok, _, err) = talus(&["bench", "--scene", "d"]);
     assert!(!ok && err.contains("--scene d"), "{err}");

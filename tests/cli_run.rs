@@ -123,6 +123,13 @@ fn run_writes_the_series_and_the_summary() {
     assert_eq!(summary["steps"], 2500);
     assert_eq!(summary["particles"], 27);
     assert_eq!(summary["threads"], 2);
+    // The time of each stage of the step, in step order; the shares add up to one.
+    let stages = summary["stages"].as_array().unwrap();
+    assert_eq!(stages.len(), 7);
+    assert_eq!(stages[0]["stage"], "integrate");
+    let share: f64 = stages.iter().map(|s| s["share"].as_f64().unwrap()).sum();
+    assert!((share - 1.0).abs() < 1e-9, "{share}");
+    assert!(stages.iter().all(|s| s["seconds"].as_f64().unwrap() >= 0.0));
     // Frames at 0, 1, ..., 5 ms and the final one.
     let pvd = std::fs::read_to_string(out_dir.join("particles.pvd")).unwrap();
     let frames = pvd.matches("<DataSet").count();
