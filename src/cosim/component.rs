@@ -87,6 +87,8 @@ pub struct WallMeans {
 /// A saved state: everything that evolves, in memory.
 #[derive(Clone, Debug)]
 pub struct ComponentState {
+    /// The fingerprint of the scene it was saved from (see [`fingerprint`]).
+    pub(super) fingerprint: u64,
     pub(super) mode: Mode,
     pub(super) sim: SimState,
     pub(super) drives: Vec<WallDrive>,
@@ -352,7 +354,9 @@ impl Component {
         let pool = self.pool.as_ref().expect("a running component has a pool");
         // Rollback through the saved state, not a copy of the whole simulation.
         let before = sim.snapshot();
-        let end = t + h;
+        // A start within round-off before the component's time must not take the
+        // clock back.
+        let end = (t + h).max(now);
         let mut impulse = vec![WallMeans::default(); drives.len()];
         let mut targets = Vec::new();
         sim.move_walls(|walls| {
@@ -414,14 +418,20 @@ impl Component {
             return Err(CosimError::Diverged(problem));
         }
         result?;
-        self.means = impulse
-            .iter()
-            .map(|m| WallMeans {
-                force: m.force / h,
-                torque: m.torque / h,
-                power: m.power / h,
-            })
-            .collect();
+        // A step too short for a sub-step (below 1e-9 of one) reports the forces of
+        // the state it leaves, not a mean of nothing.
+        self.means = if sim.steps == before.steps {
+            instantaneous_means(sim)
+        } else {
+            impulse
+                .iter()
+                .map(|m| WallMeans {
+                    force: m.force / h,
+                    torque: m.torque / h,
+                    power: m.power / h,
+                })
+                .collect()
+        };
         Ok(())
     }
 

@@ -15,6 +15,7 @@ impl Component {
             RUNNING,
         )?;
         Ok(ComponentState {
+            fingerprint: self.fingerprint,
             mode: self.mode,
             sim: self.sim.as_ref().expect("running").snapshot(),
             drives: self.drives.clone(),
@@ -29,13 +30,15 @@ impl Component {
             &[Mode::Initialisation, Mode::Step, Mode::Terminated],
             RUNNING,
         )?;
-        if state.drives.len() != self.drives.len() {
-            return Err(CosimError::State(StateError::Corrupt(
-                "a state of another scene".into(),
-            )));
+        if state.fingerprint != self.fingerprint {
+            return Err(CosimError::State(StateError::OtherScene {
+                found: state.fingerprint,
+                expected: self.fingerprint,
+            }));
         }
         self.sim.as_mut().expect("running").restore(&state.sim)?;
-        self.mode = state.mode;
+        // The life cycle is the master's: a state saved in step mode and restored
+        // during initialisation leaves the instance in initialisation.
         self.drives = state.drives.clone();
         self.means = state.means.clone();
         Ok(())
@@ -117,6 +120,7 @@ impl Component {
             return Err(corrupt("trailing bytes after the state"));
         }
         Ok(ComponentState {
+            fingerprint: self.fingerprint,
             mode,
             sim,
             drives,

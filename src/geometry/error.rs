@@ -36,6 +36,19 @@ pub enum GeometryError {
         /// Number of input points.
         count: usize,
     },
+    /// Round-off made the hull inconsistent (points spread over many orders of
+    /// magnitude, such as one vertex kilometres from the rest).
+    #[error(
+        "the convex hull of the {count} points cannot be built in floating point: point {point} \
+         sees a face whose neighbour across an edge was lost (are the coordinates spread over \
+         many orders of magnitude?)"
+    )]
+    HullRoundOff {
+        /// Number of points.
+        count: usize,
+        /// The point being added.
+        point: usize,
+    },
     /// A facet has (almost) no area.
     #[error("facet {facet} has zero area (vertices {a}, {b}, {c})")]
     ZeroAreaFacet {

@@ -135,6 +135,11 @@ pub fn dodecahedron(circumradius: Real) -> Result<ConvexPolyhedron, GeometryErro
     platonic(Platonic::Dodecahedron, circumradius)
 }
 
+/// The most sides of a prism particle, and the most points of a random convex one:
+/// beyond them a particle costs more than a bed of simpler ones.
+pub const MAX_PRISM_SIDES: usize = 10_000;
+pub const MAX_HULL_POINTS: usize = 10_000;
+
 /// Triangle mesh of an `n`-gon prism along z: `2n + 2` vertices and `4n` triangles,
 /// the caps fanned about their centres (for `n = 20`, the pellet of Xu et al.'s
 /// multiple-GPU polyhedral DEM: 42 vertices and 80 triangles). The polygon is inscribed in the circle of
@@ -147,6 +152,13 @@ pub fn prism_mesh(sides: usize, diameter: Real, length: Real) -> Result<TriMesh,
             name: "sides",
             value: sides as Real,
             reason: "a prism needs at least 3 sides",
+        });
+    }
+    if sides > MAX_PRISM_SIDES {
+        return Err(GeometryError::InvalidParameter {
+            name: "sides",
+            value: sides as Real,
+            reason: "a particle prism has at most 10 000 sides",
         });
     }
     let r = 0.5 * diameter;
@@ -253,6 +265,13 @@ pub fn random_convex(
             name: "points",
             value: points as Real,
             reason: "a convex particle needs at least 4 points",
+        });
+    }
+    if points > MAX_HULL_POINTS {
+        return Err(GeometryError::InvalidParameter {
+            name: "points",
+            value: points as Real,
+            reason: "a random convex particle has at most 10 000 points",
         });
     }
     let mut rng = Pcg64::seed_from_u64(seed);

@@ -112,7 +112,12 @@ pub fn convex_hull(points: &[Point3<Real>]) -> Result<TriMesh, GeometryError> {
             let v = faces[f].v;
             for k in 0..3 {
                 let (a, b) = (v[k], v[(k + 1) % 3]);
-                let neighbour = edge_face[&(b, a)];
+                let Some(&neighbour) = edge_face.get(&(b, a)) else {
+                    return Err(GeometryError::HullRoundOff {
+                        count: points.len(),
+                        point: p_index,
+                    });
+                };
                 if !visible.contains(&neighbour) {
                     horizon.push((a, b));
                 }

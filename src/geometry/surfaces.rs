@@ -93,15 +93,27 @@ fn direction(field: &'static str, v: &Vector3<Real>) -> Result<Unit<Vector3<Real
     }
 }
 
+/// The most polygon sides of a generated surface, and the most facets of one: a
+/// drum of 120 sides has 480 facets, and ten million facets take a gigabyte before
+/// the facet grid.
+pub const MAX_SIDES: usize = 100_000;
+pub const MAX_FACETS: usize = 10_000_000;
+
 fn sides_ok(sides: usize) -> Result<(), GeometryError> {
-    if sides >= 3 {
-        Ok(())
-    } else {
+    if sides < 3 {
         Err(GeometryError::InvalidParameter {
             name: "sides",
             value: sides as Real,
             reason: "must be at least 3",
         })
+    } else if sides > MAX_SIDES {
+        Err(GeometryError::InvalidParameter {
+            name: "sides",
+            value: sides as Real,
+            reason: "must be at most 100 000",
+        })
+    } else {
+        Ok(())
     }
 }
 
@@ -228,6 +240,13 @@ pub fn frustum_inside(
     let n = direction("axis", &axis)?;
     let (u, v) = tangent_frame(&n);
     let segments = segments.max(1);
+    if segments.saturating_mul(sides).saturating_mul(2) > MAX_FACETS {
+        return Err(GeometryError::InvalidParameter {
+            name: "segments",
+            value: segments as Real,
+            reason: "sides × segments × 2 facets must be at most ten million",
+        });
+    }
     let point = |k: usize, s: usize| {
         let a = std::f64::consts::TAU * k as Real / sides as Real;
         let f = s as Real / segments as Real;

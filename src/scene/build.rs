@@ -27,6 +27,16 @@ pub(super) struct Built {
     pub shape_names: Vec<String>,
 }
 
+/// The most worker threads a scene may ask for (as the Component's parameter).
+pub const MAX_THREADS: usize = 1024;
+
+/// The most sites a lattice may have: ten million particles is beyond what one
+/// process steps in a day, and counting the sites of a box of kilometres would spin.
+pub const MAX_LATTICE_SITES: usize = 10_000_000;
+
+/// The most particles one inlet may insert.
+pub const MAX_INLET_COUNT: usize = 100_000_000;
+
 pub(super) fn finite(path: FieldPath, values: &[Real]) -> Result<()> {
     if values.iter().all(|v| v.is_finite()) {
         Ok(())
@@ -101,6 +111,15 @@ impl<'a> Builder<'a> {
     pub fn build(mut self) -> Result<Built> {
         let sim = &self.spec.simulation;
         finite(FieldPath::root("simulation").key("gravity"), &sim.gravity)?;
+        if sim.threads > MAX_THREADS {
+            return Err(FieldError::new(
+                FieldPath::root("simulation").key("threads"),
+                format!(
+                    "{} threads; give 0 (all cores) to {MAX_THREADS}",
+                    sim.threads
+                ),
+            ));
+        }
         self.world.gravity = sim.gravity.into();
         self.materials()?;
         self.shapes()?;
@@ -245,16 +264,29 @@ impl<'a> Builder<'a> {
                 let r = self.world.body_types[t as usize].shape.circumradius();
                 let a = spacing.unwrap_or(2.1 * r);
                 positive(path.key("spacing"), a)?;
-                let n: Vec<usize> = (0..3)
+                // Sites per axis, counted in floats: a box of 1e9 m must not wrap.
+                let n: Vec<Real> = (0..3)
                     .map(|k| {
                         let span = max[k] - min[k] - 2.0 * r;
                         if span < 0.0 {
-                            0
+                            0.0
                         } else {
-                            (span / a).floor() as usize + 1
+                            (span / a).floor() + 1.0
                         }
                     })
                     .collect();
+                let sites: Real = n.iter().product();
+                if sites > MAX_LATTICE_SITES as Real {
+                    return Err(FieldError::new(
+                        path.key("max"),
+                        format!(
+                            "the lattice would have {sites:.3e} sites ({} × {} × {} at spacing {a:.3e} m); \
+                             at most {MAX_LATTICE_SITES:.0e}",
+                            n[0], n[1], n[2]
+                        ),
+                    ));
+                }
+                let n: Vec<usize> = n.iter().map(|&k| k as usize).collect();
                 if n.contains(&0) {
                     return Err(FieldError::new(
                         path.key("max"),
@@ -429,6 +461,15 @@ impl<'a> Builder<'a> {
         finite(path.key("max"), &spec.max)?;
         finite(path.key("velocity"), &spec.velocity)?;
         positive(path.key("rate"), spec.rate)?;
+        if spec.count > MAX_INLET_COUNT {
+            return Err(FieldError::new(
+                path.key("count"),
+                format!(
+                    "{} particles; an inlet inserts at most {MAX_INLET_COUNT:.0e}",
+                    spec.count
+                ),
+            ));
+        }
         if let Some(h) = spec.bed_height {
             positive(path.key("bed_height"), h)?;
         }
@@ -477,6 +518,9 @@ impl<'a> Builder<'a> {
             "material",
             path.key("material"),
         )?;
+        if let Some(r) = &w.reference {
+            finite(path.key("reference"), r)?;
+        }
         let gpath = path.key("geometry");
         let surface = self.surface(&gpath, &w.geometry)?;
         if surface.triangles.is_empty() {
@@ -525,6 +569,9 @@ impl<'a> Builder<'a> {
     }
 
     fn surface(&self, path: &FieldPath, g: &WallGeometrySpec) -> Result<Surface> {
+        for (key, value) in g.points() {
+            finite(path.key(key), value)?;
+        }
         let err = |e: crate::geometry::GeometryError| FieldError::new(path.clone(), e.to_string());
         let v = |a: &[Real; 3]| Vector3::from(*a);
         let p = |a: &[Real; 3]| Point3::from(*a);

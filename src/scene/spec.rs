@@ -367,6 +367,22 @@ pub enum WallGeometrySpec {
     },
 }
 
+impl WallGeometrySpec {
+    /// The points and directions of the geometry, by field name.
+    pub fn points(&self) -> Vec<(&'static str, &[Real; 3])> {
+        match self {
+            WallGeometrySpec::Mesh { .. } => Vec::new(),
+            WallGeometrySpec::Plane { centre, normal, .. }
+            | WallGeometrySpec::Disc { centre, normal, .. } => {
+                vec![("centre", centre), ("normal", normal)]
+            }
+            WallGeometrySpec::Box { min, max, .. } => vec![("min", min), ("max", max)],
+            WallGeometrySpec::Cylinder { base, axis, .. }
+            | WallGeometrySpec::Cone { base, axis, .. } => vec![("base", base), ("axis", axis)],
+        }
+    }
+}
+
 fn one() -> Real {
     1.0
 }
