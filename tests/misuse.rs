@@ -110,3 +110,14 @@ fn thread_counts_beyond_the_components_limit_are_refused() {
     let d = drum().replace("seed = 11", "seed = 11\nthreads = 100000");
     expect(&d, &["simulation.threads", "1024"]);
 }
+
+#[test]
+fn an_inlet_of_a_billion_particles_is_refused() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/fixed_bed/scene.toml");
+    let text = std::fs::read_to_string(path).unwrap();
+    assert!(text.contains("count = 300"));
+    expect(
+        &text.replace("count = 300", "count = 1000000000"),
+        &["inlet[0].count", "at most"],
+    );
+}
