@@ -5,7 +5,7 @@ use super::component::{Component, Mode, RUNNING, WallDrive, fingerprint};
 use super::variables::{Causality, Role, VarType, Variable, variable_table};
 use super::{CosimError, VarRef};
 use crate::Real;
-use crate::scene::Scene;
+use crate::scene::{MAX_THREADS, Scene};
 
 const ANY_BUT_ERROR: &str = "instantiated, initialisation, step, terminated";
 
@@ -254,10 +254,10 @@ impl Component {
             Self::check_type(v, VarType::Integer)?;
             self.check_writable(v)?;
             // Threads is the only settable integer.
-            if !(1..=1024).contains(x) {
+            if !(1..=MAX_THREADS as i64).contains(x) {
                 return Err(CosimError::BadValue {
                     name: v.name.clone(),
-                    problem: format!("{x} threads; give 1 to 1024"),
+                    problem: format!("{x} threads; give 1 to {MAX_THREADS}"),
                 });
             }
             if self.mode != Mode::Instantiated && *x as usize != self.params.threads {

@@ -27,7 +27,7 @@ pub(super) struct Built {
     pub shape_names: Vec<String>,
 }
 
-/// The most worker threads a scene may ask for (as the Component's parameter).
+/// The most worker threads a scene or the Component's `threads` parameter may ask for.
 pub const MAX_THREADS: usize = 1024;
 
 /// The most sites a lattice may have: ten million particles is beyond what one

@@ -20,6 +20,7 @@ pub mod state_bytes;
 
 use std::path::{Path, PathBuf};
 
+pub use build::MAX_THREADS;
 pub use error::{FieldError, FieldPath, FieldSegment, SceneError};
 pub use plan::Plan;
 pub use simulation::{Simulation, StepReport};

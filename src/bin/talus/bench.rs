@@ -413,7 +413,7 @@ fn measure(scene: &Scene, threads: usize, warmup: usize, steps: usize) -> Result
 }
 
 /// Stage shares as `name 12.3 %, ...`.
-pub fn stage_line(stages: &[(&str, f64)]) -> String {
+fn stage_line(stages: &[(&str, f64)]) -> String {
     stages
         .iter()
         .map(|(name, share)| format!("{name} {:.1} %", 100.0 * share))
