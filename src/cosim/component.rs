@@ -89,7 +89,6 @@ pub struct WallMeans {
 pub struct ComponentState {
     /// The fingerprint of the scene it was saved from (see [`fingerprint`]).
     pub(super) fingerprint: u64,
-    pub(super) mode: Mode,
     pub(super) sim: SimState,
     pub(super) drives: Vec<WallDrive>,
     pub(super) means: Vec<WallMeans>,

@@ -1,9 +1,11 @@
 //! Saved states: in memory for a rollback, and as bytes (FMI serialised states, the
 //! zenoh `state` queryable). The bytes are the simulation's state (see
-//! [`crate::scene::state`]) followed by the component's inputs, outputs and mode.
+//! [`crate::scene::state`]) followed by the component's wall drives and means, and a
+//! CRC-32 of all of it. The life-cycle mode is not part of a state: it is the master's.
 
 use super::CosimError;
 use super::component::{Component, ComponentState, Mode, RUNNING, WallDrive, WallMeans};
+use crate::scene::state_bytes::STATE_MAGIC;
 use crate::scene::{SimState, StateError, StateReader, StateWriter};
 
 impl Component {
@@ -16,7 +18,6 @@ impl Component {
         )?;
         Ok(ComponentState {
             fingerprint: self.fingerprint,
-            mode: self.mode,
             sim: self.sim.as_ref().expect("running").snapshot(),
             drives: self.drives.clone(),
             means: self.means.clone(),
@@ -48,11 +49,6 @@ impl Component {
     pub fn state_to_bytes(&self, state: &ComponentState) -> Vec<u8> {
         let mut w = StateWriter::default();
         state.sim.write(self.fingerprint, &mut w);
-        w.u64(match state.mode {
-            Mode::Initialisation => 1,
-            Mode::Step => 2,
-            _ => 3,
-        });
         for (d, m) in state.drives.iter().zip(&state.means) {
             match d {
                 WallDrive::Prescribed => w.u64(0),
@@ -74,7 +70,7 @@ impl Component {
             w.vec3(&m.torque);
             w.f64(m.power);
         }
-        w.into_bytes()
+        w.into_checked()
     }
 
     /// A state from bytes written by [`Component::state_to_bytes`] for this scene.
@@ -85,16 +81,13 @@ impl Component {
             &[Mode::Initialisation, Mode::Step, Mode::Terminated],
             RUNNING,
         )?;
-        let mut r = StateReader::new(bytes);
+        if !bytes.starts_with(STATE_MAGIC) {
+            return Err(StateError::NotAState.into());
+        }
+        let mut r = StateReader::checked(bytes)?;
         let sim = SimState::read(self.fingerprint, &mut r)?;
         self.sim.as_ref().expect("running").check_state(&sim)?;
         let corrupt = |m: &str| CosimError::State(StateError::Corrupt(m.into()));
-        let mode = match r.u64()? {
-            1 => Mode::Initialisation,
-            2 => Mode::Step,
-            3 => Mode::Terminated,
-            _ => return Err(corrupt("unknown mode")),
-        };
         let mut drives = Vec::new();
         let mut means = Vec::new();
         for _ in 0..self.drives.len() {
@@ -121,7 +114,6 @@ impl Component {
         }
         Ok(ComponentState {
             fingerprint: self.fingerprint,
-            mode,
             sim,
             drives,
             means,

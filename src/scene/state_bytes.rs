@@ -11,7 +11,10 @@
 //!
 //! The format is little-endian, versioned by a magic string; every count is checked
 //! against what is left, so garbage bytes give an error, never a panic or a huge
-//! allocation.
+//! allocation. A container that holds a state (the Component's saved state, a run's
+//! checkpoint) ends with a CRC-32 of everything before it ([`StateWriter::into_checked`],
+//! [`StateReader::checked`]): a flipped or lost byte is refused before anything is
+//! read.
 
 use nalgebra::{Isometry3, Point3, Quaternion, Translation3, UnitQuaternion, Vector3};
 use thiserror::Error;
@@ -23,7 +26,9 @@ use crate::engine::ContactHistory;
 use crate::engine::StepStats;
 use crate::world::Particles;
 
-const MAGIC: &[u8; 8] = b"TALUSST3";
+/// The header of a state; the digit is the format's version (4: states in checked
+/// containers).
+pub const STATE_MAGIC: &[u8; 8] = b"TALUSST4";
 
 /// Why bytes could not be restored as a state.
 #[derive(Debug, Error, PartialEq)]
@@ -42,6 +47,16 @@ pub enum StateError {
     /// The bytes end early or hold an impossible value.
     #[error("corrupt state: {0}")]
     Corrupt(String),
+    /// The checksum at the end does not match the bytes (damaged or truncated).
+    #[error(
+        "damaged state: its checksum is {found:#010x}, the bytes give {computed:#010x} (truncated or changed after it was written)"
+    )]
+    Checksum {
+        /// The checksum stored at the end.
+        found: u32,
+        /// The checksum of the bytes before it.
+        computed: u32,
+    },
 }
 
 /// Appends values to a byte buffer.
@@ -54,6 +69,19 @@ impl StateWriter {
     /// The bytes written.
     pub fn into_bytes(self) -> Vec<u8> {
         self.bytes
+    }
+
+    /// The bytes written followed by their CRC-32 (read back by
+    /// [`StateReader::checked`]).
+    pub fn into_checked(mut self) -> Vec<u8> {
+        let crc = crate::checksum::crc32(&self.bytes);
+        self.bytes.extend_from_slice(&crc.to_le_bytes());
+        self.bytes
+    }
+
+    /// Magic bytes heading a container.
+    pub fn magic(&mut self, magic: &[u8]) {
+        self.bytes.extend_from_slice(magic);
     }
 
     /// An unsigned integer.
@@ -94,6 +122,35 @@ impl<'a> StateReader<'a> {
     /// A reader at the start of `bytes`.
     pub fn new(bytes: &'a [u8]) -> Self {
         StateReader { bytes, at: 0 }
+    }
+
+    /// A reader of bytes written by [`StateWriter::into_checked`], once their checksum
+    /// matched; it reads up to the checksum.
+    pub fn checked(bytes: &'a [u8]) -> Result<Self, StateError> {
+        let Some(body_len) = bytes.len().checked_sub(4) else {
+            return Err(StateError::Corrupt(format!(
+                "{} bytes are too few for a state",
+                bytes.len()
+            )));
+        };
+        let (body, tail) = bytes.split_at(body_len);
+        let found = u32::from_le_bytes(tail.try_into().expect("4 bytes"));
+        let computed = crate::checksum::crc32(body);
+        if found != computed {
+            return Err(StateError::Checksum { found, computed });
+        }
+        Ok(StateReader::new(body))
+    }
+
+    /// Whether the next bytes are `magic` (taken when they are).
+    pub fn magic(&mut self, magic: &[u8]) -> bool {
+        let at = self.at;
+        if self.take(magic.len()).ok() == Some(magic) {
+            true
+        } else {
+            self.at = at;
+            false
+        }
     }
 
     fn take(&mut self, n: usize) -> Result<&'a [u8], StateError> {
@@ -181,7 +238,7 @@ fn read_history(r: &mut StateReader) -> Result<TangentialHistory, StateError> {
 impl SimState {
     /// Writes the state, headed by the scene's `fingerprint`.
     pub fn write(&self, fingerprint: u64, w: &mut StateWriter) {
-        w.bytes.extend_from_slice(MAGIC);
+        w.magic(STATE_MAGIC);
         w.u64(fingerprint);
         w.f64(self.time);
         w.f64(self.dt);
@@ -247,7 +304,7 @@ impl SimState {
     /// [`StateReader::is_done`] or reads on). Whether it fits the scene (body types,
     /// walls, facets, inlets) is checked when it is restored.
     pub fn read(fingerprint: u64, r: &mut StateReader) -> Result<SimState, StateError> {
-        if r.take(MAGIC.len()).ok() != Some(&MAGIC[..]) {
+        if !r.magic(STATE_MAGIC) {
             return Err(StateError::NotAState);
         }
         let found = r.u64()?;
