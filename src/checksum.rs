@@ -1,4 +1,5 @@
-//! Checksums of the file formats talus writes (zip archives, PNG images).
+//! Checksums of the file formats talus writes (zip archives, PNG images, saved states
+//! and checkpoints) and the FNV-1a fingerprint of scenes.
 
 /// CRC-32 (IEEE 802.3, reflected, as zip and PNG use it).
 pub fn crc32(data: &[u8]) -> u32 {
@@ -23,6 +24,17 @@ pub fn crc32_update(crc: u32, data: &[u8]) -> u32 {
         table[((c ^ b as u32) & 0xff) as usize] ^ (c >> 8)
     })
 }
+
+/// FNV-1a, 64 bits, from `seed` (0xcbf2_9ce4_8422_2325 is the standard offset): a
+/// fingerprint stable across Rust versions and platforms.
+pub fn fnv1a(bytes: &[u8], seed: u64) -> u64 {
+    bytes
+        .iter()
+        .fold(seed, |h, b| (h ^ *b as u64).wrapping_mul(0x0100_0000_01b3))
+}
+
+/// The standard FNV-1a offset basis.
+pub const FNV_OFFSET: u64 = 0xcbf2_9ce4_8422_2325;
 
 /// Adler-32 (the zlib stream checksum).
 pub fn adler32(data: &[u8]) -> u32 {

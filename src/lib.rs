@@ -28,6 +28,7 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod analysis;
+pub mod checkpoint;
 pub mod checksum;
 pub mod contact;
 pub mod cosim;

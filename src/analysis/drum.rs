@@ -13,7 +13,7 @@
 //! (`x_c` the bed's centre of mass), which is recorded alongside as a check.
 
 use nalgebra::{Point3, Vector3};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use super::field::VelocityField;
 use super::surface::{SurfaceFit, fit_surface};
@@ -23,7 +23,7 @@ use crate::world::World;
 /// A drum resolved against the world: which walls turn together, the axis and the
 /// part of the cross-section that is analysed. Axis and centre are kept in the first
 /// wall's frame so that they follow the drum wherever it is moved.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Drum {
     /// The drum's walls (indices into the world's walls); the first carries the axis.
     pub walls: Vec<usize>,
@@ -146,7 +146,7 @@ impl Drum {
 }
 
 /// Impulses over an interval of time.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
 struct Impulses {
     span: Real,
     drive: Real,
@@ -188,7 +188,7 @@ pub struct DrumRow {
 }
 
 /// Figures of one revolution.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Revolution {
     /// Revolution number, from 1.
     pub number: usize,
@@ -250,8 +250,9 @@ pub struct DrumSummary {
     pub slice: Real,
 }
 
-/// Follows a drum through a run: fed after every step, sampled at intervals.
-#[derive(Clone, Debug)]
+/// Follows a drum through a run: fed after every step, sampled at intervals. It
+/// serialises (serde) so that a resumed run's checkpoint carries what it summed.
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct DrumMonitor {
     drum: Drum,
     row: Impulses,

@@ -8,7 +8,7 @@ use crate::Real;
 /// cross-section coordinates `(h, v)` about the axis (cells of edge `cell`).
 /// Invariant: `count`, `volume` and the velocity sums have `n²` entries, row `j`
 /// (height) after row `j − 1`.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct VelocityField {
     /// Drum radius, m.
     pub radius: Real,

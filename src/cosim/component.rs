@@ -145,13 +145,7 @@ pub fn fingerprint(scene: &Scene) -> u64 {
     for v in variable_table(scene) {
         text.push_str(&v.name);
     }
-    fnv1a(text.as_bytes(), 0xcbf2_9ce4_8422_2325)
-}
-
-fn fnv1a(bytes: &[u8], seed: u64) -> u64 {
-    bytes
-        .iter()
-        .fold(seed, |h, b| (h ^ *b as u64).wrapping_mul(0x0100_0000_01b3))
+    crate::checksum::fnv1a(text.as_bytes(), crate::checksum::FNV_OFFSET)
 }
 
 pub(super) const RUNNING: &str = "initialisation, step, terminated";

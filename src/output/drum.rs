@@ -47,6 +47,21 @@ impl DrumOutput {
         })
     }
 
+    /// Takes up a drum's files where a checkpoint left them: `drum.csv` cut to its
+    /// first `csv_len` bytes, the monitor as it was.
+    pub fn resume(dir: &Path, monitor: DrumMonitor, csv_len: u64) -> io::Result<Self> {
+        Ok(DrumOutput {
+            monitor,
+            csv: BufWriter::new(super::resume::open_at(&dir.join("drum.csv"), csv_len)?),
+        })
+    }
+
+    /// Flushes `drum.csv` and tells how many bytes it holds.
+    pub fn written(&mut self) -> io::Result<u64> {
+        self.csv.flush()?;
+        Ok(self.csv.get_ref().metadata()?.len())
+    }
+
     /// The monitor (for its figures while running).
     pub fn monitor(&self) -> &DrumMonitor {
         &self.monitor

@@ -10,11 +10,16 @@
 //!   between rows is lost); with a drum, its drive torque and power at the end;
 //! - `series.csv`: particles, contacts, kinetic energy and largest speed;
 //! - `summary.json`: the run's figures;
-//! - with a `[drum]` section, the drum's files (see [`drum`]).
+//! - with a `[drum]` section, the drum's files (see [`drum`]);
+//! - `checkpoint.talus` and `checkpoint.prev.talus` (when checkpoints are asked for or
+//!   the run is interrupted): the last two checkpoints, see [`crate::checkpoint`]; a
+//!   resumed run takes up the files above where a checkpoint left them
+//!   ([`OutputCursor`]).
 
 pub mod drum;
 pub mod packing;
 pub mod png;
+mod resume;
 pub mod vtk;
 
 use std::fs::File;
@@ -29,6 +34,7 @@ use crate::analysis::{Drum, DrumSummary};
 use crate::engine::{Stage, StageTimes};
 use crate::world::World;
 use drum::DrumOutput;
+pub use resume::OutputCursor;
 use vtk::Collection;
 
 /// Time spent in one stage of the steps of a run.

@@ -239,9 +239,28 @@ impl Collection {
         }
     }
 
+    /// A collection of these frames (time, file), written now unless empty: a
+    /// resumed run's.
+    pub fn restore(path: PathBuf, frames: Vec<(Real, String)>) -> io::Result<Self> {
+        let c = Collection { path, frames };
+        if !c.frames.is_empty() {
+            c.write()?;
+        }
+        Ok(c)
+    }
+
+    /// The frames (time, file).
+    pub fn frames(&self) -> &[(Real, String)] {
+        &self.frames
+    }
+
     /// Adds a frame at `time` and rewrites the collection.
     pub fn add(&mut self, time: Real, file: String) -> io::Result<()> {
         self.frames.push((time, file));
+        self.write()
+    }
+
+    fn write(&self) -> io::Result<()> {
         let mut s = String::from(
             "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n  <Collection>\n",
         );

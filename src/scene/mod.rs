@@ -64,6 +64,13 @@ pub struct Scene {
 }
 
 impl Scene {
+    /// A 64-bit fingerprint of the scene as written and of the talus version: what a
+    /// run's checkpoint carries so that it resumes only the scene it was written for.
+    pub fn fingerprint(&self) -> u64 {
+        let text = format!("talus {} {:?}", env!("CARGO_PKG_VERSION"), self.spec);
+        crate::checksum::fnv1a(text.as_bytes(), crate::checksum::FNV_OFFSET)
+    }
+
     /// Reads and validates a scene file.
     pub fn load(path: &Path) -> Result<Scene, SceneError> {
         let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
@@ -151,6 +158,7 @@ impl Scene {
         for o in [
             ("frame_interval", spec.output.frame_interval),
             ("csv_interval", spec.output.csv_interval),
+            ("checkpoint_interval", spec.output.checkpoint_interval),
         ] {
             if let (name, Some(v)) = o
                 && !(v.is_finite() && v > 0.0)

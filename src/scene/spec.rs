@@ -236,6 +236,9 @@ pub struct OutputSpec {
     pub frame_interval: Option<Real>,
     /// Interval between rows of `walls.csv` and `energy.csv`, s (none: every frame).
     pub csv_interval: Option<Real>,
+    /// Interval of simulated time between checkpoints of `talus run`, s (none: only
+    /// `--checkpoint-every` and an interrupted run write one).
+    pub checkpoint_interval: Option<Real>,
 }
 
 /// A material (SI units).

@@ -2,6 +2,7 @@
 
 mod analyze;
 mod bench;
+mod checkpoint;
 mod contact;
 mod fmu;
 mod run;
@@ -32,13 +33,23 @@ enum Command {
         /// The scene (TOML).
         scene: PathBuf,
     },
-    /// Run a scene: progress, ParaView series, walls.csv, series.csv, summary.json.
+    /// Run a scene: progress, ParaView series, walls.csv, series.csv, summary.json;
+    /// checkpoints with [output] checkpoint_interval or --checkpoint-every (and when
+    /// interrupted), from which --resume continues.
     Run {
-        /// The scene (TOML).
-        scene: PathBuf,
+        /// The scene (TOML); with --resume, the checkpoint's scene by default.
+        #[arg(required_unless_present = "resume")]
+        scene: Option<PathBuf>,
         /// Output directory (default: the scene's [output] dir, or <scene>_out).
-        #[arg(long)]
+        #[arg(long, conflicts_with = "resume")]
         out: Option<PathBuf>,
+        /// Continue the run in this output directory from its newest checkpoint; the
+        /// outputs then equal those of a run never stopped.
+        #[arg(long, value_name = "OUT_DIR")]
+        resume: Option<PathBuf>,
+        /// Also write a checkpoint every this many minutes of wall-clock time.
+        #[arg(long, value_name = "MINUTES", value_parser = positive_minutes)]
+        checkpoint_every: Option<std::time::Duration>,
         /// Worker threads (default: the scene's, else all cores).
         #[arg(long, default_value_t = 0)]
         threads: usize,
@@ -140,14 +151,18 @@ fn main() -> Result<()> {
         Command::Run {
             scene,
             out,
+            resume,
+            checkpoint_every,
             threads,
             quiet,
         } => run::run(
-            &scene,
+            scene.as_deref(),
             run::RunOptions {
                 out,
                 threads,
                 quiet,
+                resume,
+                checkpoint_every,
             },
         ),
         Command::Contact { file } => contact::contact(&file),
@@ -204,6 +219,16 @@ fn main() -> Result<()> {
             print_shape(&mesh.display().to_string(), &shape);
             Ok(())
         }
+    }
+}
+
+/// A positive, finite number of minutes.
+fn positive_minutes(text: &str) -> Result<std::time::Duration, String> {
+    match text.parse::<f64>() {
+        Ok(m) if m.is_finite() && m > 0.0 && m < 1e9 => {
+            Ok(std::time::Duration::from_secs_f64(m * 60.0))
+        }
+        _ => Err(format!("{text} is not a positive number of minutes")),
     }
 }
 

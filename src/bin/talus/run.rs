@@ -1,5 +1,6 @@
 //! `talus check` and `talus run`: validate a scene, print its plan, and run it with
-//! progress, ParaView output, CSV series and a summary.
+//! progress, ParaView output, CSV series and a summary; checkpoints on the way, and
+//! resumption from them.
 
 use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
@@ -9,11 +10,15 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
+use talus::Real;
+use talus::checkpoint::{Checkpoint, RunProgress};
 use talus::output::{RunOutput, StageSummary, Summary, WallSummary};
 use talus::scene::{Scene, Simulation};
 
+use crate::checkpoint;
+
 /// Loads a scene, printing its warnings.
-fn load(path: &Path) -> Result<Scene> {
+pub fn load(path: &Path) -> Result<Scene> {
     let scene = Scene::load(path)?;
     for w in &scene.warnings {
         eprintln!("warning: {w}");
@@ -37,11 +42,26 @@ pub struct RunOptions {
     pub threads: usize,
     /// No progress bar.
     pub quiet: bool,
+    /// Resume the run in this output directory from its newest checkpoint.
+    pub resume: Option<PathBuf>,
+    /// Also write a checkpoint after this much wall-clock time.
+    pub checkpoint_every: Option<Duration>,
 }
 
-/// `talus run`.
-pub fn run(path: &Path, options: RunOptions) -> Result<()> {
-    let scene = load(path)?;
+/// `talus run` of the scene at `path` (optional with `resume`: the checkpoint names
+/// its scene).
+pub fn run(path: Option<&Path>, options: RunOptions) -> Result<()> {
+    let (scene, dir, start) = match &options.resume {
+        Some(dir) => {
+            let (scene, checkpoint) = checkpoint::resume(dir, path)?;
+            (scene, dir.clone(), Some(checkpoint))
+        }
+        None => {
+            let scene = load(path.context("a scene file is needed (or --resume)")?)?;
+            let dir = options.out.clone().unwrap_or_else(|| scene.output_dir());
+            (scene, dir, None)
+        }
+    };
     let threads = match (options.threads, scene.spec.simulation.threads) {
         (0, 0) => std::thread::available_parallelism().map_or(1, |n| n.get()),
         (0, t) | (t, _) => t,
@@ -50,7 +70,6 @@ pub fn run(path: &Path, options: RunOptions) -> Result<()> {
         .num_threads(threads)
         .build()
         .context("cannot start the worker threads")?;
-    let dir = options.out.clone().unwrap_or_else(|| scene.output_dir());
     let stop = Arc::new(AtomicBool::new(false));
     {
         let stop = stop.clone();
@@ -62,26 +81,108 @@ pub fn run(path: &Path, options: RunOptions) -> Result<()> {
         })
         .context("cannot install the Ctrl-C handler")?;
     }
-    pool.install(|| run_loop(&scene, &dir, threads, &stop, options.quiet))
+    let checkpoints = Checkpoints::new(&scene, &dir, options.checkpoint_every, threads);
+    pool.install(|| run_loop(&scene, &dir, start, checkpoints, &stop, options.quiet))
+}
+
+/// When and where a run writes its checkpoints.
+struct Checkpoints {
+    dir: PathBuf,
+    /// The scene file, absolute.
+    scene: PathBuf,
+    fingerprint: u64,
+    interval: Option<Real>,
+    every: Option<Duration>,
+    last: Instant,
+    threads: usize,
+}
+
+impl Checkpoints {
+    fn new(scene: &Scene, dir: &Path, every: Option<Duration>, threads: usize) -> Self {
+        Checkpoints {
+            dir: dir.to_path_buf(),
+            scene: std::fs::canonicalize(&scene.file).unwrap_or_else(|_| scene.file.clone()),
+            fingerprint: scene.fingerprint(),
+            interval: scene.spec.output.checkpoint_interval,
+            every,
+            last: Instant::now(),
+            threads,
+        }
+    }
+
+    /// Whether a checkpoint is due after a step of length `dt` that ended at `t`: at
+    /// each multiple of the interval, and after `every` of wall-clock time.
+    fn due(&self, t: Real, dt: Real) -> bool {
+        let crossed = self.interval.is_some_and(|i| {
+            let eps = 1e-9 * dt;
+            ((t + eps) / i).floor() > ((t - dt + eps) / i).floor()
+        });
+        crossed || self.every.is_some_and(|e| self.last.elapsed() >= e)
+    }
+
+    /// Writes one of the simulation and the outputs as they are now.
+    fn write(
+        &mut self,
+        sim: &Simulation,
+        out: &mut RunOutput,
+        progress: RunProgress,
+    ) -> Result<()> {
+        let checkpoint = Checkpoint {
+            scene: self.scene.clone(),
+            progress: RunProgress {
+                threads: self.threads,
+                ..progress
+            },
+            output: out.cursor()?,
+            sim: sim.snapshot(),
+        };
+        checkpoint::write(&self.dir, &checkpoint.to_bytes(self.fingerprint))
+            .with_context(|| format!("cannot write a checkpoint in {}", self.dir.display()))?;
+        self.last = Instant::now();
+        Ok(())
+    }
 }
 
 fn run_loop(
     scene: &Scene,
     dir: &Path,
-    threads: usize,
+    start: Option<Checkpoint>,
+    mut checkpoints: Checkpoints,
     stop: &AtomicBool,
     quiet: bool,
 ) -> Result<()> {
     let mut sim = Simulation::new(scene);
-    let mut out = RunOutput::create(
-        dir,
-        sim.world(),
-        scene.spec.output.frame_interval,
-        scene.spec.output.csv_interval,
-        scene.drum.as_ref(),
-    )
-    .with_context(|| format!("cannot write to {}", dir.display()))?;
-    out.record(sim.world(), 0.0, sim.stats().contacts, true)?;
+    let frame_interval = scene.spec.output.frame_interval;
+    let csv_interval = scene.spec.output.csv_interval;
+    let (mut out, before) = match start {
+        None => {
+            let mut out = RunOutput::create(
+                dir,
+                sim.world(),
+                frame_interval,
+                csv_interval,
+                scene.drum.as_ref(),
+            )
+            .with_context(|| format!("cannot write to {}", dir.display()))?;
+            out.record(sim.world(), 0.0, sim.stats().contacts, true)?;
+            (out, RunProgress::default())
+        }
+        Some(c) => {
+            sim.restore(&c.sim)
+                .context("the checkpoint does not fit its scene")?;
+            let out = RunOutput::resume(dir, frame_interval, csv_interval, c.output)
+                .with_context(|| format!("cannot take up the outputs in {}", dir.display()))?;
+            if !quiet {
+                eprintln!(
+                    "resuming at t = {:.6e} s after {} steps from {}",
+                    sim.time(),
+                    sim.steps,
+                    dir.join(checkpoint::FILE).display()
+                );
+            }
+            (out, c.progress)
+        }
+    };
     let total_steps = (sim.end_time / scene.dt).ceil() as u64;
     let bar = if quiet {
         ProgressBar::hidden()
@@ -93,8 +194,14 @@ fn run_loop(
             .expect("valid template"),
     );
     let started = Instant::now();
-    let mut contact_sum = 0u64;
-    let mut particle_steps = 0u64;
+    let mut contact_sum = before.contact_sum;
+    let mut particle_steps = before.particle_steps;
+    let progress = |contact_sum, particle_steps| RunProgress {
+        contact_sum,
+        particle_steps,
+        wall_clock_s: before.wall_clock_s + started.elapsed().as_secs_f64(),
+        threads: 0,
+    };
     let mut last_draw = Instant::now();
     // What ends a run, in this order: Ctrl-C, the end time, the settling criterion.
     let stopped = |sim: &Simulation| {
@@ -115,6 +222,12 @@ fn run_loop(
                 particle_steps += stats.integrated as u64;
                 contact_sum += stats.contacts as u64;
                 if let Err(e) = out.record(sim.world(), taken, stats.contacts, false) {
+                    return ControlFlow::Break(Err(e.into()));
+                }
+                if checkpoints.due(sim.time(), taken)
+                    && let Err(e) =
+                        checkpoints.write(sim, &mut out, progress(contact_sum, particle_steps))
+                {
                     return ControlFlow::Break(Err(e));
                 }
                 if last_draw.elapsed() > Duration::from_millis(200) {
@@ -139,9 +252,18 @@ fn run_loop(
         }
     };
     bar.finish_and_clear();
+    if ended_by == "interrupted" {
+        // Before the last frame and row, which an uninterrupted run would not write.
+        checkpoints.write(&sim, &mut out, progress(contact_sum, particle_steps))?;
+        eprintln!(
+            "interrupted at t = {:.6e} s; continue with: talus run --resume {}",
+            sim.time(),
+            dir.display()
+        );
+    }
     out.record(sim.world(), 0.0, sim.stats().contacts, true)?;
     let drum = out.finish(sim.world())?;
-    let elapsed = started.elapsed().as_secs_f64();
+    let elapsed = before.wall_clock_s + started.elapsed().as_secs_f64();
     let report = sim.report();
     let summary = Summary {
         // Absolute, so that `talus analyze` finds it from anywhere.
@@ -173,7 +295,7 @@ fn run_loop(
                 torque: w.torque.into(),
             })
             .collect(),
-        threads,
+        threads: checkpoints.threads,
         stages: StageSummary::of(sim.stage_times()),
         drum,
     };
