@@ -513,3 +513,60 @@ fn states_keep_to_their_scene_and_leave_the_life_cycle_to_the_master() {
     assert!(err.to_string().contains("another scene"), "{err}");
     assert_eq!(time(&empty), 0.0);
 }
+
+#[test]
+fn a_time_step_far_above_the_suggested_one_warns_and_its_blow_up_is_caught() {
+    // The case: dt = 5e-3 s through the parameter, 230 times the suggested
+    // step of the drum's beads. The bed's energy grows from nothing while every value
+    // stays finite; the step that breaks the energy balance is refused and rolled back.
+    let mut c = drum("drum.toml");
+    assert!(c.warnings().is_empty(), "{:?}", c.warnings());
+    let dt = c.variable("dt").unwrap();
+    c.set_real_vector(dt, &[5e-3]).unwrap();
+    let warnings = c.warnings();
+    assert_eq!(warnings.len(), 1);
+    assert!(warnings[0].contains("above the suggested"), "{warnings:?}");
+    let times: f64 = warnings[0]
+        .split("s (")
+        .nth(1)
+        .and_then(|s| s.split(" times").next())
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!((200.0..260.0).contains(&times), "{}", warnings[0]);
+    c.enter_initialization_mode(0.0).unwrap();
+    c.exit_initialization_mode().unwrap();
+    set_spin(&mut c, 3.0);
+    let mut t = 0.0;
+    let diverged = loop {
+        let before = (time(&c), vector(&c, "kinetic_energy")[0]);
+        match c.do_step(t, 0.05) {
+            Ok(()) => t += 0.05,
+            Err(e) => {
+                assert_eq!((time(&c), vector(&c, "kinetic_energy")[0]), before);
+                break e;
+            }
+        }
+        assert!(t < 2.0, "no divergence reported in 2 s");
+    };
+    println!("refused at t = {t}: {diverged}");
+    assert!(matches!(diverged, CosimError::Diverged(_)), "{diverged}");
+    assert!(
+        diverged.to_string().contains("energy balance"),
+        "{diverged}"
+    );
+    // 96 beads of 0.67 g: what the bed held before the refused step is of the order
+    // of what the drum can give it, far below the 17 kJ the step would have made.
+    let kinetic = vector(&c, "kinetic_energy")[0];
+    assert!(kinetic < 0.1, "{kinetic} J");
+}
+
+#[test]
+fn the_stable_drum_keeps_its_energy_balance_for_a_second() {
+    // The same drum at its own step: no step is refused over 20 communication steps.
+    let mut c = started("drum.toml");
+    set_spin(&mut c, 6.0);
+    for k in 0..20 {
+        c.do_step(0.05 * k as f64, 0.05).unwrap();
+    }
+}

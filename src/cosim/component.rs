@@ -7,6 +7,7 @@ use std::path::{Path, PathBuf};
 use nalgebra::{Point3, Quaternion, UnitQuaternion, Vector3};
 
 use super::CosimError;
+use super::divergence::{self, EnergyBalance};
 use super::pool::JoinedPool;
 use super::variables::{Variable, variable_table};
 use crate::Real;
@@ -200,6 +201,15 @@ impl Component {
         &self.scene
     }
 
+    /// What a user should know about the scene at the current parameters (a time
+    /// step above the suggested one), as `talus check` says it. The FMI faces log
+    /// these when initialisation starts.
+    pub fn warnings(&self) -> Vec<String> {
+        crate::scene::time_step_warning(self.params.dt, self.scene.suggested.as_ref())
+            .into_iter()
+            .collect()
+    }
+
     /// The current mode.
     pub fn mode(&self) -> Mode {
         self.mode
@@ -347,6 +357,7 @@ impl Component {
         let pool = self.pool.as_ref().expect("a running component has a pool");
         // Rollback through the saved state, not a copy of the whole simulation.
         let before = sim.snapshot();
+        let balance = EnergyBalance::start(sim);
         // A start within round-off before the component's time must not take the
         // clock back.
         let end = (t + h).max(now);
@@ -405,7 +416,10 @@ impl Component {
             }
         });
         self.output = output;
-        if let Some(problem) = divergence(sim) {
+        let wall_work = impulse.iter().map(|m| m.power).sum();
+        if let Some(problem) =
+            divergence::non_finite(sim).or_else(|| balance.broken(sim, wall_work))
+        {
             sim.restore(&before)
                 .expect("a snapshot of this simulation restores");
             return Err(CosimError::Diverged(problem));
@@ -525,21 +539,4 @@ fn instantaneous_means(sim: &Simulation) -> Vec<WallMeans> {
             power: w.power(),
         })
         .collect()
-}
-
-/// What is not finite in the state, if anything.
-fn divergence(sim: &Simulation) -> Option<String> {
-    let p = &sim.world().particles;
-    for i in 0..p.len() {
-        if !(p.position[i].coords.iter().all(|x| x.is_finite())
-            && p.velocity[i].iter().all(|x| x.is_finite())
-            && p.angular_momentum[i].iter().all(|x| x.is_finite()))
-        {
-            return Some(format!(
-                "particle {} has a non-finite position or velocity",
-                p.id[i]
-            ));
-        }
-    }
-    None
 }

@@ -14,7 +14,8 @@
 //! ```
 //! A call in the wrong mode, a non-finite input, a bad step size: an error, and the
 //! component is unchanged. A step whose state blows up (a non-finite position or
-//! velocity) is rolled back to its start and reported.
+//! velocity, or energy gained from nothing beyond all the scene holds: see
+//! [`divergence`]) is rolled back to its start and reported.
 //!
 //! # Communication steps
 //! `do_step(t, h)` runs DEM steps of the `dt` parameter, the last one shortened so
@@ -25,6 +26,7 @@
 
 mod access;
 mod component;
+mod divergence;
 mod error;
 pub mod pool;
 mod saved;

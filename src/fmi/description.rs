@@ -135,6 +135,10 @@ fn header(out: &mut String, c: &Component, model: &str, version: FmiVersion) {
     );
     let _ = writeln!(
         out,
+        r#"    <Category name="logStatusWarning" description="Settings a user should check (a time step above the suggested one)"/>"#
+    );
+    let _ = writeln!(
+        out,
         r#"    <Category name="logEvents" description="Life-cycle events"/>"#
     );
     let _ = writeln!(out, "  </LogCategories>");

@@ -150,6 +150,7 @@ pub unsafe extern "C" fn fmi2EnterInitializationMode(c: Component) -> Status {
         inst.component
             .enter_initialization_mode(t)
             .map_err(|e| e.to_string())?;
+        inst.log_warnings();
         Ok(OK)
     })
 }

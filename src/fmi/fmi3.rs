@@ -185,6 +185,7 @@ pub unsafe extern "C" fn fmi3EnterInitializationMode(
         inst.component
             .enter_initialization_mode(start_time)
             .map_err(|e| e.to_string())?;
+        inst.log_warnings();
         Ok(OK)
     })
 }

@@ -36,6 +36,7 @@ pub const SCENE_FILE: &str = "scene.toml";
 
 /// Status codes (the same numbers in FMI 2 and 3).
 pub(crate) const OK: c_int = 0;
+pub(crate) const WARNING: c_int = 1;
 pub(crate) const ERROR: c_int = 3;
 
 /// The guid (FMI 2) or instantiation token (FMI 3) of a scene's FMU.
@@ -219,6 +220,13 @@ impl Instance {
             category,
             message,
         );
+    }
+
+    /// Logs the component's warnings (as `talus check` gives them) as warnings.
+    pub fn log_warnings(&self) {
+        for w in self.component.warnings() {
+            self.log(WARNING, "logStatusWarning", &w);
+        }
     }
 
     /// Keeps strings alive for the master and returns their pointers.

@@ -63,6 +63,20 @@ pub struct Scene {
     pub shape_names: Vec<String>,
 }
 
+/// The warning a time step `dt` above the suggested one deserves (also for a step set
+/// after loading, through the Component's `dt` parameter).
+pub fn time_step_warning(dt: Real, suggested: Option<&TimeStepEstimate>) -> Option<String> {
+    let s = suggested.filter(|s| dt > s.dt)?;
+    Some(format!(
+        "dt = {dt:.3e} s is above the suggested {:.3e} s ({:.3} times it; {:.3} steps per period \
+         of the stiffest contact, {}); contacts may be under-resolved or unstable",
+        s.dt,
+        dt / s.dt,
+        s.period / dt,
+        s.limited_by
+    ))
+}
+
 impl Scene {
     /// A 64-bit fingerprint of the scene as written and of the talus version: what a
     /// run's checkpoint carries so that it resumes only the scene it was written for.
@@ -134,17 +148,7 @@ impl Scene {
                         format!("{dt} must be a positive number of seconds or \"auto\""),
                     ));
                 }
-                if let Some(s) = &suggested
-                    && *dt > s.dt
-                {
-                    warnings.push(format!(
-                        "dt = {dt:.3e} s is above the suggested {:.3e} s ({:.3} steps per period \
-                         of the stiffest contact, {}); contacts may be under-resolved or unstable",
-                        s.dt,
-                        s.period / dt,
-                        s.limited_by
-                    ));
-                }
+                warnings.extend(time_step_warning(*dt, suggested.as_ref()));
                 *dt
             }
             (spec::TimeStepSpec::Auto, Some(s)) => s.dt,

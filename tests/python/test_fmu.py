@@ -243,6 +243,35 @@ def test_misuse_gets_an_error_status_and_a_logged_message(fmus, version, tmp_pat
         bad.freeLibrary()
 
 
+@pytest.mark.parametrize("version", [2, 3])
+def test_a_time_step_far_above_the_suggested_one_warns_and_diverges_with_an_error(fmus, version):
+    # dt = 5e-3 s, 230 times the suggested step: the same warning as `talus check`
+    # is logged at initialisation, and the first step, whose energy balance breaks,
+    # is refused and leaves the state as it was.
+    md, unzipped, s = slave(fmus[("drum", version)], version)
+    log = Log()
+    if version == 2:
+        s.instantiate(callbacks=log.fmi2())
+        s.setupExperiment(startTime=0.0)
+        s.setReal(vrs(md, "dt"), [5e-3])
+    else:
+        s.instantiate(logMessage=log.fmi3())
+        s.setFloat64(vrs(md, "dt"), [5e-3])
+    s.enterInitializationMode()
+    warned = [m for status, m in log.messages if status == 1]
+    assert len(warned) == 1 and "above the suggested" in warned[0], log.messages
+    s.exitInitializationMode()
+    spin, out = drum_io(md, version)
+    set_spin(s, version, spin, OMEGA)
+    before = outputs(s, version, out)
+    with pytest.raises(FMICallException):
+        s.doStep(currentCommunicationPoint=0.0, communicationStepSize=0.05)
+    assert "energy balance" in log.last(), log.messages
+    assert outputs(s, version, out) == before
+    s.terminate()
+    s.freeInstance()
+
+
 def threads():
     return len(os.listdir("/proc/self/task"))
 

@@ -1,0 +1,118 @@
+//! When a communication step has diverged: a non-finite position or velocity, or an
+//! energy balance broken grossly (the state stays finite, but the bed gained energy
+//! that neither the walls nor gravity gave it: the signature of a time step far
+//! above the stable one).
+//!
+//! The balance of a step: the mechanical energy of the particles present at its
+//! start (kinetic + gravitational potential + elastic energy of the contacts) may
+//! rise by at most the work the walls delivered; contacts only dissipate. An explicit
+//! integrator at a stable step breaks this by a small fraction of a collision's
+//! energy (`validation_energy`: 3e-5 of the total over 100 collisions per particle).
+//! A step is diverged when the energy created exceeds the scale of all the energy
+//! the scene could hold: the kinetic and elastic energy at the start, the walls'
+//! work, and the potential energy of lifting the whole bed across the scene's
+//! extent. A step that doubles the bed's energy from nothing is caught; what a
+//! stable or slightly under-resolved step does is far below it.
+
+use crate::Real;
+use crate::scene::Simulation;
+
+/// The mechanical energy of a step's start and the scale it is judged against.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct EnergyBalance {
+    /// Particles at the start (inserted ones are not counted after the step).
+    particles: usize,
+    /// Mechanical energy at the start, J.
+    start: Real,
+    /// Kinetic + elastic energy at the start and the bed's potential energy across
+    /// the scene's extent, J.
+    scale: Real,
+}
+
+/// Kinetic + gravitational potential energy of the first `n` owned particles, J.
+fn particle_energy(sim: &Simulation, n: usize) -> (Real, Real) {
+    let w = sim.world();
+    let p = &w.particles;
+    let (mut kinetic, mut potential) = (0.0, 0.0);
+    for i in 0..n.min(p.owned()) {
+        let t = &w.body_types[p.body_type[i] as usize];
+        let lb = p.orientation[i].inverse_transform_vector(&p.angular_momentum[i]);
+        kinetic += 0.5 * t.mass * p.velocity[i].norm_squared()
+            + 0.5 * lb.dot(&lb.component_div(&t.inertia));
+        potential -= t.mass * w.gravity.dot(&p.position[i].coords);
+    }
+    (kinetic, potential)
+}
+
+impl EnergyBalance {
+    /// The balance of a step that starts now.
+    pub(super) fn start(sim: &Simulation) -> Self {
+        let w = sim.world();
+        let n = w.particles.owned();
+        let (kinetic, potential) = particle_energy(sim, n);
+        let elastic = sim.stats().elastic_energy;
+        let mass: Real = (0..n)
+            .map(|i| w.body_types[w.particles.body_type[i] as usize].mass)
+            .sum();
+        EnergyBalance {
+            particles: n,
+            start: kinetic + potential + elastic,
+            scale: kinetic + elastic + mass * w.gravity.norm() * extent(sim),
+        }
+    }
+
+    /// The energy created in the step beyond `wall_work` (J delivered by the walls),
+    /// when it is gross.
+    pub(super) fn broken(&self, sim: &Simulation, wall_work: Real) -> Option<String> {
+        let (kinetic, potential) = particle_energy(sim, self.particles);
+        let end = kinetic + potential + sim.stats().elastic_energy;
+        let created = end - self.start - wall_work;
+        let scale = self.scale + wall_work.abs();
+        (created > scale).then(|| {
+            format!(
+                "the energy balance is broken: the particles gained {created:.3e} J that neither \
+                 the walls ({wall_work:.3e} J of work) nor gravity gave them, more than all the \
+                 energy the scene holds ({scale:.3e} J; kinetic energy now {kinetic:.3e} J); \
+                 the time step {:.3e} s is too long for these contacts",
+                sim.dt()
+            )
+        })
+    }
+}
+
+/// The diagonal of the box around the walls and the particles, m.
+fn extent(sim: &Simulation) -> Real {
+    let w = sim.world();
+    let mut lo = [Real::INFINITY; 3];
+    let mut hi = [Real::NEG_INFINITY; 3];
+    let mut add = |x: &[Real]| {
+        for k in 0..3 {
+            lo[k] = lo[k].min(x[k]);
+            hi[k] = hi[k].max(x[k]);
+        }
+    };
+    for wall in &w.walls {
+        for v in &wall.vertices {
+            add((wall.pose * v).coords.as_slice());
+        }
+    }
+    for x in &w.particles.position[..w.particles.owned()] {
+        add(x.coords.as_slice());
+    }
+    if lo[0] > hi[0] {
+        return 0.0;
+    }
+    (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<Real>().sqrt()
+}
+
+/// What is not finite in the state, if anything.
+pub(super) fn non_finite(sim: &Simulation) -> Option<String> {
+    let p = &sim.world().particles;
+    (0..p.len())
+        .find(|&i| {
+            !(p.position[i].coords.iter().all(|x| x.is_finite())
+                && p.velocity[i].iter().all(|x| x.is_finite())
+                && p.angular_momentum[i].iter().all(|x| x.is_finite()))
+        })
+        .map(|i| format!("particle {} has a non-finite position or velocity", p.id[i]))
+}
