@@ -200,3 +200,58 @@ fn an_interrupted_run_leaves_valid_outputs() {
     let pvd = std::fs::read_to_string(out_dir.join("particles.pvd")).unwrap();
     assert!(pvd.trim_end().ends_with("</VTKFile>"));
 }
+
+#[test]
+fn a_run_that_blows_up_stops_with_the_step_and_finite_outputs() {
+    // The settling box at 50 times its suggested step: the dodecahedra gain hundreds
+    // of joules from nothing and leave the box; the run stops at the first energy
+    // check that sees it, names the step, and no row or frame after it is written.
+    let dir = scratch("blow_up");
+    std::fs::create_dir_all(&dir).unwrap();
+    let text = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/settling_box/scene.toml"),
+    )
+    .unwrap()
+    .replace("dt = \"auto\"", "dt = 3.827e-4");
+    let scene = dir.join("scene.toml");
+    std::fs::write(&scene, text).unwrap();
+    let out_dir = dir.join("out");
+    let out = talus()
+        .args(["run", "--quiet", "--out"])
+        .arg(&out_dir)
+        .arg(&scene)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{err}");
+    assert!(
+        err.contains("the run diverged") && err.contains("energy balance"),
+        "{err}"
+    );
+    assert!(
+        err.contains("the time step 3.827e-4 s is too long"),
+        "{err}"
+    );
+    let step: u64 = err
+        .split("up to step ")
+        .nth(1)
+        .and_then(|s| s.split(' ').next())
+        .unwrap()
+        .parse()
+        .unwrap();
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out_dir.join("summary.json")).unwrap())
+            .unwrap();
+    assert_eq!(summary["ended_by"], "diverged");
+    assert_eq!(summary["steps"].as_u64().unwrap(), step);
+    // Every row before is finite, and the last row is before the step.
+    let series = std::fs::read_to_string(out_dir.join("series.csv")).unwrap();
+    let rows: Vec<Vec<f64>> = series
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+        .collect();
+    assert!(rows.iter().flatten().all(|x| x.is_finite()));
+    let t_step = summary["time"].as_f64().unwrap();
+    assert!(rows.last().unwrap()[0] < t_step);
+}

@@ -220,6 +220,27 @@ fn removing_a_particle_keeps_the_others_history() {
     );
 }
 
+#[test]
+fn the_first_non_finite_particle_is_named() {
+    let scene = Scene::parse(BOX, Path::new("box.toml")).unwrap();
+    let mut sim = Simulation::new(&scene);
+    let _ = sim.advance_to(1e-3, |_, _| ControlFlow::<()>::Continue(()));
+    assert_eq!(sim.first_non_finite(), None);
+    let (a, b) = (sim.world().particles.id[40], sim.world().particles.id[70]);
+    sim.edit_world(|w| {
+        w.particles.velocity[70].y = f64::NAN;
+        w.particles.position[40].z = f64::INFINITY;
+    });
+    assert_eq!(sim.first_non_finite(), Some(a));
+    // Stepping a blown-up state answers (non-finite values), never panics or hangs:
+    // the broad phase bins a non-finite particle into a corner cell.
+    let t = sim.time();
+    let _ = sim.advance_to(t + 1e-4, |_, _| ControlFlow::<()>::Continue(()));
+    assert_eq!(sim.first_non_finite(), Some(a));
+    sim.edit_world(|w| w.particles.position[40].z = 0.01);
+    assert_eq!(sim.first_non_finite(), Some(b));
+}
+
 /// The sync calls a backend received, in order.
 type Calls = Arc<Mutex<Vec<String>>>;
 

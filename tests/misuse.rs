@@ -121,3 +121,14 @@ fn an_inlet_of_a_billion_particles_is_refused() {
         &["inlet[0].count", "at most"],
     );
 }
+
+#[test]
+fn a_tiny_end_time_prints_as_a_number_not_300_digits() {
+    let text = drum().replace("end_time = 4.0", "end_time = 1e-300");
+    assert!(text.contains("1e-300"));
+    let scene = Scene::parse(&text, Path::new("scene.toml")).unwrap();
+    let plan = scene.plan.to_string();
+    let line = plan.lines().find(|l| l.contains("end time")).unwrap();
+    assert!(line.contains("end time 1e-300 s"), "{line}");
+    assert!(line.len() < 200, "{line}");
+}

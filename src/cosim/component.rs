@@ -7,11 +7,11 @@ use std::path::{Path, PathBuf};
 use nalgebra::{Point3, Quaternion, UnitQuaternion, Vector3};
 
 use super::CosimError;
-use super::divergence::{self, EnergyBalance};
 use super::pool::JoinedPool;
 use super::variables::{Variable, variable_table};
 use crate::Real;
 use crate::output::RunOutput;
+use crate::scene::energy_balance::EnergyBalance;
 use crate::scene::{Scene, SimState, Simulation};
 use crate::world::{DriveInput, WallMotion};
 
@@ -417,8 +417,10 @@ impl Component {
         });
         self.output = output;
         let wall_work = impulse.iter().map(|m| m.power).sum();
-        if let Some(problem) =
-            divergence::non_finite(sim).or_else(|| balance.broken(sim, wall_work))
+        if let Some(problem) = sim
+            .first_non_finite()
+            .map(|id| format!("particle {id} has a non-finite position, velocity or force"))
+            .or_else(|| balance.broken(sim, wall_work))
         {
             sim.restore(&before)
                 .expect("a snapshot of this simulation restores");

@@ -15,7 +15,7 @@
 //! A call in the wrong mode, a non-finite input, a bad step size: an error, and the
 //! component is unchanged. A step whose state blows up (a non-finite position or
 //! velocity, or energy gained from nothing beyond all the scene holds: see
-//! [`divergence`]) is rolled back to its start and reported.
+//! [`crate::scene::energy_balance`]) is rolled back to its start and reported.
 //!
 //! # Communication steps
 //! `do_step(t, h)` runs DEM steps of the `dt` parameter, the last one shortened so
@@ -26,7 +26,6 @@
 
 mod access;
 mod component;
-mod divergence;
 mod error;
 pub mod pool;
 mod saved;

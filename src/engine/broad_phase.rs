@@ -127,13 +127,24 @@ impl BroadPhase {
             (ratio.log2().floor().max(0.0) as usize).min(MAX_LEVELS - 1) as u8
         }));
         let used = *self.level_of.iter().max().unwrap_or(&0) as usize + 1;
-        let (lo, hi) = positions.iter().fold(
-            (
-                Vector3::repeat(Real::INFINITY),
-                Vector3::repeat(Real::NEG_INFINITY),
-            ),
-            |(lo, hi), p| (lo.inf(&p.coords), hi.sup(&p.coords)),
-        );
+        // The box of the finite positions: a particle that went non-finite (a blown-up
+        // state, reported by the caller after the step) is binned into a corner cell,
+        // never sizing the grid.
+        let (lo, hi) = positions
+            .iter()
+            .filter(|p| p.coords.iter().all(|x| x.is_finite()))
+            .fold(
+                (
+                    Vector3::repeat(Real::INFINITY),
+                    Vector3::repeat(Real::NEG_INFINITY),
+                ),
+                |(lo, hi), p| (lo.inf(&p.coords), hi.sup(&p.coords)),
+            );
+        let (lo, hi) = if lo.x <= hi.x {
+            (lo, hi)
+        } else {
+            (Vector3::zeros(), Vector3::zeros())
+        };
         self.origin = lo;
         let extent = hi - lo;
         // A sparse scene must not allocate a huge grid: coarsen until the cell count is
@@ -147,7 +158,7 @@ impl BroadPhase {
                 grid.cell *= 2.0;
             }
             let d = cells_along(grid.cell);
-            grid.dims = [d.x as usize, d.y as usize, d.z as usize];
+            grid.dims = [d.x, d.y, d.z].map(|x| (x as usize).max(1));
             let cells = grid.dims.iter().product::<usize>();
             grid.starts.clear();
             grid.starts.resize(cells + 1, 0);

@@ -9,6 +9,7 @@
 
 mod analyses;
 mod build;
+pub mod energy_balance;
 mod error;
 mod locate;
 mod plan;

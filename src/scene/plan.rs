@@ -171,7 +171,7 @@ impl Plan {
         line(
             format!(
                 "time step: {dt:.4e} s, end time {} s",
-                spec.simulation.end_time
+                readable(spec.simulation.end_time)
             ),
             match suggested {
                 Some(s) => format!(
@@ -221,5 +221,15 @@ impl fmt::Display for Plan {
             writeln!(f, "{what:<60} ({why})")?;
         }
         Ok(())
+    }
+}
+
+/// A number as written in a scene when it is of everyday size, else in scientific
+/// notation (an end time of 1e-300 s is not printed as 300 digits).
+fn readable(x: Real) -> String {
+    if x == 0.0 || (1e-4..1e7).contains(&x.abs()) {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
     }
 }

@@ -334,6 +334,22 @@ impl Simulation {
         self.inlets.iter().all(Inlet::is_done)
     }
 
+    /// The id of the first owned particle whose position, velocity, angular momentum
+    /// or force is not finite: the state has blown up (a time step far above the
+    /// stable one).
+    pub fn first_non_finite(&self) -> Option<u64> {
+        let p = &self.world.particles;
+        let finite = |v: &[Real]| v.iter().all(|x| x.is_finite());
+        (0..p.owned())
+            .find(|&i| {
+                !(finite(p.position[i].coords.as_slice())
+                    && finite(p.velocity[i].as_slice())
+                    && finite(p.angular_momentum[i].as_slice())
+                    && finite(p.force[i].as_slice()))
+            })
+            .map(|i| p.id[i])
+    }
+
     /// Whether the scene's settling criterion has held long enough.
     pub fn is_settled(&self) -> bool {
         match (&self.settle, self.quiet_since) {

@@ -13,6 +13,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use talus::Real;
 use talus::checkpoint::{Checkpoint, RunProgress};
 use talus::output::{RunOutput, StageSummary, Summary, WallSummary};
+use talus::scene::energy_balance::EnergyBalance;
 use talus::scene::{Scene, Simulation};
 
 use crate::checkpoint;
@@ -84,6 +85,10 @@ pub fn run(path: Option<&Path>, options: RunOptions) -> Result<()> {
     let checkpoints = Checkpoints::new(&scene, &dir, options.checkpoint_every, threads);
     pool.install(|| run_loop(&scene, &dir, start, checkpoints, &stop, options.quiet))
 }
+
+/// Steps between two checks of the energy balance (see
+/// `talus::scene::energy_balance`): a blow-up is stopped within them.
+const BALANCE_STEPS: u64 = 200;
 
 /// When and where a run writes its checkpoints.
 struct Checkpoints {
@@ -213,11 +218,46 @@ fn run_loop(
             None
         }
     };
+    // Why the run diverged: the first particle that went non-finite, or the energy
+    // balance of the last BALANCE_STEPS steps broken grossly.
+    let mut blown_up: Option<String> = None;
+    let mut balance = EnergyBalance::start(&sim);
+    let mut wall_work = 0.0;
     let ended_by = match stopped(&sim) {
         Some(reason) => reason,
         None => {
             let end = sim.end_time;
             let advanced = sim.advance_to(end, |sim, taken| {
+                // Before anything of this step is written: the outputs stay finite.
+                if let Some(id) = sim.first_non_finite() {
+                    blown_up = Some(format!(
+                        "particle {id} went non-finite (position, velocity or force) in step {} \
+                         at t = {:.6e} s; the outputs hold the run up to the step before{}",
+                        sim.steps,
+                        sim.time(),
+                        scene.suggested.as_ref().map_or(String::new(), |s| format!(
+                            "; the time step {:.3e} s is {:.3} times the suggested {:.3e} s",
+                            sim.dt(),
+                            sim.dt() / s.dt,
+                            s.dt
+                        ))
+                    ));
+                    return ControlFlow::Break(Ok("diverged"));
+                }
+                wall_work += taken * sim.world().walls.iter().map(|w| w.power()).sum::<Real>();
+                if sim.steps % BALANCE_STEPS == 0 {
+                    if let Some(problem) = balance.broken(sim, wall_work) {
+                        blown_up = Some(format!(
+                            "in the {BALANCE_STEPS} steps up to step {} (t = {:.6e} s), {problem}; \
+                             the outputs hold the run up to the step before",
+                            sim.steps,
+                            sim.time()
+                        ));
+                        return ControlFlow::Break(Ok("diverged"));
+                    }
+                    balance = EnergyBalance::start(sim);
+                    wall_work = 0.0;
+                }
                 let stats = sim.stats();
                 particle_steps += stats.integrated as u64;
                 contact_sum += stats.contacts as u64;
@@ -261,7 +301,9 @@ fn run_loop(
             dir.display()
         );
     }
-    out.record(sim.world(), 0.0, sim.stats().contacts, true)?;
+    if blown_up.is_none() {
+        out.record(sim.world(), 0.0, sim.stats().contacts, true)?;
+    }
     let drum = out.finish(sim.world())?;
     let elapsed = before.wall_clock_s + started.elapsed().as_secs_f64();
     let report = sim.report();
@@ -300,6 +342,9 @@ fn run_loop(
         drum,
     };
     out.write_summary(&summary)?;
+    if let Some(message) = blown_up {
+        anyhow::bail!("{}: the run diverged: {message}", scene.file.display());
+    }
     if let Some(bed) = &scene.bed {
         crate::analyze::write_bed_files(scene, bed, sim.world(), dir)?;
     }

@@ -1,9 +1,10 @@
-//! When a communication step has diverged: a non-finite position or velocity, or an
-//! energy balance broken grossly (the state stays finite, but the bed gained energy
-//! that neither the walls nor gravity gave it: the signature of a time step far
-//! above the stable one).
+//! Whether a stretch of a run has diverged although every value stays finite: the
+//! energy balance broken grossly, the bed having gained energy that neither the
+//! walls nor gravity gave it (the signature of a time step far above the stable one,
+//! whose particles then leave the scene at hundreds of m/s). The Component judges
+//! each communication step by it, `talus run` every few hundred steps.
 //!
-//! The balance of a step: the mechanical energy of the particles present at its
+//! The balance of a stretch: the mechanical energy of the particles present at its
 //! start (kinetic + gravitational potential + elastic energy of the contacts) may
 //! rise by at most the work the walls delivered; contacts only dissipate. An explicit
 //! integrator at a stable step breaks this by a small fraction of a collision's
@@ -14,12 +15,12 @@
 //! extent. A step that doubles the bed's energy from nothing is caught; what a
 //! stable or slightly under-resolved step does is far below it.
 
+use super::Simulation;
 use crate::Real;
-use crate::scene::Simulation;
 
 /// The mechanical energy of a step's start and the scale it is judged against.
 #[derive(Clone, Copy, Debug)]
-pub(super) struct EnergyBalance {
+pub struct EnergyBalance {
     /// Particles at the start (inserted ones are not counted after the step).
     particles: usize,
     /// Mechanical energy at the start, J.
@@ -45,8 +46,8 @@ fn particle_energy(sim: &Simulation, n: usize) -> (Real, Real) {
 }
 
 impl EnergyBalance {
-    /// The balance of a step that starts now.
-    pub(super) fn start(sim: &Simulation) -> Self {
+    /// The balance of a stretch that starts now.
+    pub fn start(sim: &Simulation) -> Self {
         let w = sim.world();
         let n = w.particles.owned();
         let (kinetic, potential) = particle_energy(sim, n);
@@ -61,9 +62,9 @@ impl EnergyBalance {
         }
     }
 
-    /// The energy created in the step beyond `wall_work` (J delivered by the walls),
-    /// when it is gross.
-    pub(super) fn broken(&self, sim: &Simulation, wall_work: Real) -> Option<String> {
+    /// The energy created since the start beyond `wall_work` (J the walls delivered
+    /// meanwhile), when it is gross.
+    pub fn broken(&self, sim: &Simulation, wall_work: Real) -> Option<String> {
         let (kinetic, potential) = particle_energy(sim, self.particles);
         let end = kinetic + potential + sim.stats().elastic_energy;
         let created = end - self.start - wall_work;
@@ -103,16 +104,4 @@ fn extent(sim: &Simulation) -> Real {
         return 0.0;
     }
     (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<Real>().sqrt()
-}
-
-/// What is not finite in the state, if anything.
-pub(super) fn non_finite(sim: &Simulation) -> Option<String> {
-    let p = &sim.world().particles;
-    (0..p.len())
-        .find(|&i| {
-            !(p.position[i].coords.iter().all(|x| x.is_finite())
-                && p.velocity[i].iter().all(|x| x.is_finite())
-                && p.angular_momentum[i].iter().all(|x| x.is_finite()))
-        })
-        .map(|i| format!("particle {} has a non-finite position or velocity", p.id[i]))
 }
