@@ -570,3 +570,18 @@ fn the_stable_drum_keeps_its_energy_balance_for_a_second() {
         c.do_step(0.05 * k as f64, 0.05).unwrap();
     }
 }
+
+#[test]
+fn a_step_of_more_than_1e8_dem_steps_is_refused() {
+    // dt = 1e-300 s through the parameter: a 10 ms step would take 1e298 DEM steps
+    // (the process would hang); it is refused and nothing changes.
+    let mut c = drum("drum.toml");
+    let dt = c.variable("dt").unwrap();
+    c.set_real_vector(dt, &[1e-300]).unwrap();
+    c.enter_initialization_mode(0.0).unwrap();
+    c.exit_initialization_mode().unwrap();
+    let err = c.do_step(0.0, 0.01).unwrap_err();
+    assert!(matches!(err, CosimError::BadStep(_)), "{err}");
+    assert!(err.to_string().contains("at most 1e8"), "{err}");
+    assert_eq!(time(&c), 0.0);
+}

@@ -149,6 +149,10 @@ pub fn fingerprint(scene: &Scene) -> u64 {
     crate::checksum::fnv1a(text.as_bytes(), crate::checksum::FNV_OFFSET)
 }
 
+/// The most DEM steps one `do_step` may take (hours of a small scene): a step far
+/// longer than the time step is refused instead of hanging the master.
+pub const MAX_SUBSTEPS: Real = 1e8;
+
 pub(super) const RUNNING: &str = "initialisation, step, terminated";
 
 impl Component {
@@ -346,6 +350,14 @@ impl Component {
         if !t.is_finite() || (t - now).abs() > 1e-9 * now.abs().max(h) {
             return Err(CosimError::BadStep(format!(
                 "the step starts at {t} but the component is at time {now}"
+            )));
+        }
+        let substeps = (h / self.params.dt).ceil();
+        if !(substeps <= MAX_SUBSTEPS) {
+            return Err(CosimError::BadStep(format!(
+                "the step of {h:e} s would take {substeps:e} DEM steps of {:e} s; at most \
+                 {MAX_SUBSTEPS:e} in one call (a longer step, or a larger dt)",
+                self.params.dt
             )));
         }
         let drives = self.drives.clone();

@@ -2,7 +2,7 @@
 //! particle mesh into a checked template.
 
 use std::fs::File;
-use std::io::BufReader;
+use std::io::Cursor;
 use std::path::Path;
 
 use nalgebra::Point3;
@@ -54,10 +54,28 @@ pub fn read_mesh(path: &Path) -> Result<TriMesh, GeometryError> {
 
 /// Reads an ASCII or binary STL file; vertices with identical coordinates are merged.
 pub fn read_stl(path: &Path) -> Result<TriMesh, GeometryError> {
-    let file = File::open(path).map_err(|e| file_error(path, e.to_string()))?;
-    let mut reader = BufReader::new(file);
-    let mesh = stl_io::read_stl(&mut reader)
-        .map_err(|e| file_error(path, format!("not a valid STL file: {e}")))?;
+    let bytes = std::fs::read(path).map_err(|e| file_error(path, e.to_string()))?;
+    parse_stl(&bytes, path)
+}
+
+/// Reads ASCII or binary STL bytes (`path` names them in errors). Nothing is
+/// allocated ahead of what the bytes hold: a binary header claiming billions of
+/// facets ends in an error at the end of the bytes.
+pub fn parse_stl(bytes: &[u8], path: &Path) -> Result<TriMesh, GeometryError> {
+    let mesh = stl_io::read_stl(&mut Cursor::new(bytes)).map_err(|e| {
+        let claim = match bytes.get(80..84) {
+            Some(n) => {
+                let n = u32::from_le_bytes(n.try_into().expect("4 bytes")) as u64;
+                format!(
+                    "; read as binary, its header claims {n} facets ({} bytes), and it holds {}",
+                    84 + 50 * n,
+                    bytes.len()
+                )
+            }
+            None => String::new(),
+        };
+        file_error(path, format!("not a valid STL file: {e}{claim}"))
+    })?;
     if mesh.faces.is_empty() {
         return Err(file_error(path, "the STL file holds no facets"));
     }
@@ -73,6 +91,11 @@ pub fn read_stl(path: &Path) -> Result<TriMesh, GeometryError> {
 /// Reads the vertices (`v`) and faces (`f`, fan-triangulated) of a Wavefront OBJ file.
 pub fn read_obj(path: &Path) -> Result<TriMesh, GeometryError> {
     let text = std::fs::read_to_string(path).map_err(|e| file_error(path, e.to_string()))?;
+    parse_obj(&text, path)
+}
+
+/// Reads OBJ text (`path` names it in errors).
+pub fn parse_obj(text: &str, path: &Path) -> Result<TriMesh, GeometryError> {
     let mut vertices = Vec::new();
     let mut triangles = Vec::new();
     for (line_no, line) in text.lines().enumerate() {

@@ -91,6 +91,12 @@ pub fn write_poses(dir: &Path, world: &World, shape_names: &[String]) -> io::Res
 /// checked against the world's body types.
 pub fn read_poses(path: &Path, world: &mut World) -> Result<(), String> {
     let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    parse_poses(&text, path, world)
+}
+
+/// Reads `poses.csv` text (`path` names it in errors) into `world`, as
+/// [`read_poses`]; on error the world's particles are left empty or partial.
+pub fn parse_poses(text: &str, path: &Path, world: &mut World) -> Result<(), String> {
     let mut lines = text.lines().enumerate();
     match lines.next() {
         Some((_, h)) if h.trim() == "id,kind,shape,x,y,z,qw,qx,qy,qz" => {}
