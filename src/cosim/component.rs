@@ -4,7 +4,7 @@ use std::fmt;
 use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 
-use nalgebra::{Point3, Quaternion, UnitQuaternion, Vector3};
+use nalgebra::{Point3, UnitQuaternion, Vector3};
 
 use super::CosimError;
 use super::pool::JoinedPool;
@@ -352,12 +352,20 @@ impl Component {
                 "the step starts at {t} but the component is at time {now}"
             )));
         }
-        let substeps = (h / self.params.dt).ceil();
+        // The step length in use: the parameter's, or a restored state's.
+        let dt = self.sim.as_ref().expect("step mode").dt();
+        // At a time so large that a DEM step is below the clock's resolution, the
+        // clock would not advance (and the step would never end).
+        if !((now + dt) - now > 0.5 * dt) {
+            return Err(CosimError::BadStep(format!(
+                "at t = {now:e} s a DEM step of {dt:e} s is below the resolution of the clock"
+            )));
+        }
+        let substeps = (h / dt).ceil();
         if !(substeps <= MAX_SUBSTEPS) {
             return Err(CosimError::BadStep(format!(
-                "the step of {h:e} s would take {substeps:e} DEM steps of {:e} s; at most \
-                 {MAX_SUBSTEPS:e} in one call (a longer step, or a larger dt)",
-                self.params.dt
+                "the step of {h:e} s would take {substeps:e} DEM steps of {dt:e} s; at most \
+                 {MAX_SUBSTEPS:e} in one call (a longer step, or a larger dt)"
             )));
         }
         let drives = self.drives.clone();
@@ -535,12 +543,8 @@ fn initial_drives(scene: &Scene) -> Vec<WallDrive> {
 }
 
 fn unit_quaternion(q: &[Real; 4]) -> UnitQuaternion<Real> {
-    let q = Quaternion::new(q[0], q[1], q[2], q[3]);
-    if q.norm() > 0.0 {
-        UnitQuaternion::from_quaternion(q)
-    } else {
-        UnitQuaternion::identity()
-    }
+    crate::geometry::unit_quaternion(q[0], q[1], q[2], q[3])
+        .unwrap_or_else(UnitQuaternion::identity)
 }
 
 fn instantaneous_means(sim: &Simulation) -> Vec<WallMeans> {

@@ -148,7 +148,8 @@ pub fn parse_poses(text: &str, path: &Path, world: &mut World) -> Result<(), Str
         let q = if (q.norm() - 1.0).abs() < 1e-12 {
             UnitQuaternion::new_unchecked(q)
         } else {
-            UnitQuaternion::from_quaternion(q)
+            crate::geometry::unit_quaternion(v[3], v[4], v[5], v[6])
+                .ok_or_else(|| at("the quaternion is not a rotation"))?
         };
         world
             .particles

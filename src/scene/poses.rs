@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use nalgebra::{Point3, Quaternion, UnitQuaternion, Vector3};
+use nalgebra::{Point3, UnitQuaternion, Vector3};
 
 use crate::Real;
 
@@ -69,13 +69,12 @@ pub fn parse_poses(text: &str) -> Result<Vec<PoseRecord>, String> {
                 v[7 + k] = value(*c)?;
             }
         }
-        let q = Quaternion::new(v[3], v[4], v[5], v[6]);
-        if !(q.norm() > 1e-9) {
+        let Some(orientation) = crate::geometry::unit_quaternion(v[3], v[4], v[5], v[6]) else {
             return Err(format!("{}: the quaternion is zero", l + 1));
-        }
+        };
         out.push(PoseRecord {
             position: Point3::new(v[0], v[1], v[2]),
-            orientation: UnitQuaternion::from_quaternion(q),
+            orientation,
             velocity: Vector3::new(v[7], v[8], v[9]),
             angular_velocity: Vector3::new(v[10], v[11], v[12]),
         });

@@ -132,6 +132,7 @@ impl Simulation {
 
     /// Sets the step length of the steps to come.
     pub fn set_time_step(&mut self, dt: Real) {
+        debug_assert!(dt.is_finite() && dt > 0.0, "time step {dt}");
         self.dt = dt;
     }
 
@@ -238,7 +239,7 @@ impl Simulation {
         let before = self.world.time;
         self.backend.step(&mut self.world, dt);
         self.backend.sync_to_host(&mut self.world);
-        self.steps += 1;
+        self.steps = self.steps.saturating_add(1);
         self.follow_bed(before);
         self.insert();
         self.update_settling();

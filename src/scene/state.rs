@@ -161,6 +161,12 @@ impl Simulation {
     /// The inlets as `state` has them, after checking that it fits the scene.
     fn restored_inlets(&self, state: &SimState) -> Result<Vec<crate::world::Inlet>, StateError> {
         let corrupt = |m: String| Err(StateError::Corrupt(m));
+        if !(state.dt.is_finite() && state.dt > 0.0) {
+            return corrupt(format!("time step {} is not a positive number", state.dt));
+        }
+        if !state.time.is_finite() {
+            return corrupt(format!("time {} is not finite", state.time));
+        }
         let world = &self.world;
         let types = world.body_types.len() as u64;
         let p = &state.particles;
@@ -168,6 +174,19 @@ impl Simulation {
             return corrupt(format!(
                 "particle {} has body type {}; the scene has {types}",
                 p.id[i], p.body_type[i]
+            ));
+        }
+        let finite = |v: &[Real]| v.iter().all(|x| x.is_finite());
+        if let Some(i) = (0..p.len()).find(|&i| {
+            !(finite(p.position[i].coords.as_slice())
+                && finite(p.velocity[i].as_slice())
+                && finite(p.angular_momentum[i].as_slice())
+                && finite(p.force[i].as_slice())
+                && finite(p.torque[i].as_slice()))
+        }) {
+            return corrupt(format!(
+                "particle {} has a non-finite position, velocity or force",
+                p.id[i]
             ));
         }
         if state.walls.len() != world.walls.len() {

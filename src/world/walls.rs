@@ -156,7 +156,26 @@ impl FacetGrid {
         }
         let mut cell = cell.max(Real::MIN_POSITIVE);
         let count = |cell: Real| (hi - lo).map(|e| (e / cell).floor() + 1.0);
-        while count(cell).product() > (1 << 22) as Real {
+        const MOST: Real = (1 << 22) as Real;
+        while count(cell).product() > MOST {
+            cell *= 2.0;
+        }
+        // Each facet is listed in every cell its box covers: a few facets much larger
+        // than the cells (a tube kilometres long) must not make billions of entries.
+        let covered = |cell: Real| -> Real {
+            triangles
+                .iter()
+                .map(|t| {
+                    let pts = t.map(|v| vertices[v as usize].coords);
+                    let a = pts[0].inf(&pts[1]).inf(&pts[2]) - lo;
+                    let b = pts[0].sup(&pts[1]).sup(&pts[2]) - lo;
+                    (0..3)
+                        .map(|k| (b[k] / cell).floor() - (a[k] / cell).floor() + 1.0)
+                        .product::<Real>()
+                })
+                .sum()
+        };
+        while covered(cell) > MOST.max(8.0 * triangles.len() as Real) {
             cell *= 2.0;
         }
         let d = count(cell);
