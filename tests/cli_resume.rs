@@ -9,48 +9,15 @@ use std::time::{Duration, Instant, SystemTime};
 
 use rand::{Rng, SeedableRng};
 
-/// A lid pressed into 27 dodecahedra: contacts from the start, a frame and a row every
-/// millisecond, a checkpoint every 4 ms.
-const SCENE: &str = r#"
-[simulation]
-dt = 2e-6
-end_time = END
-gravity = [0.0, 0.0, -9.81]
+mod common;
 
-[output]
-frame_interval = 0.001
-checkpoint_interval = 0.004
-
-[materials.pla]
-density = 1500.0
-young = 1e6
-poisson = 0.1
-restitution = 0.3
-friction = 0.5
-
-[shapes.dodecahedron]
-kind = "platonic"
-solid = "dodecahedron"
-circumradius = 0.005
-
-[[wall]]
-name = "box"
-material = "pla"
-geometry = { kind = "box", min = [0.0, 0.0, 0.0], max = [0.04, 0.04, 0.1], open_top = true }
-
-[[wall]]
-name = "lid"
-material = "pla"
-geometry = { kind = "plane", centre = [0.02, 0.02, 0.09], normal = [0.0, 0.0, -1.0], size = 0.04 }
-motion = { kind = "linear", velocity = [0.0, 0.0, -0.5] }
-
-[[particles]]
-kind = "lattice"
-shape = "dodecahedron"
-material = "pla"
-min = [0.0, 0.0, 0.0]
-max = [0.04, 0.04, 0.04]
-"#;
+/// The lid pressed into 27 dodecahedra, with a checkpoint every 4 ms.
+fn scene_text() -> String {
+    common::LID_BOX.replace(
+        "frame_interval = 0.001",
+        "frame_interval = 0.001\ncheckpoint_interval = 0.004",
+    )
+}
 
 fn scratch(name: &str) -> PathBuf {
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);
@@ -61,7 +28,7 @@ fn scratch(name: &str) -> PathBuf {
 
 fn write_scene(dir: &Path, end: &str) -> PathBuf {
     let path = dir.join("scene.toml");
-    std::fs::write(&path, SCENE.replace("END", end)).unwrap();
+    std::fs::write(&path, scene_text().replace("END", end)).unwrap();
     path
 }
 
@@ -255,12 +222,12 @@ fn damaged_foreign_and_missing_checkpoints_are_refused() {
     // Another scene: the scene file changed since.
     std::fs::write(&newest, &good).unwrap();
     std::fs::remove_file(&previous).unwrap();
-    std::fs::write(&scene, SCENE.replace("END", "0.02")).unwrap();
+    std::fs::write(&scene, scene_text().replace("END", "0.02")).unwrap();
     let err = refused("another scene");
     assert!(err.contains("another scene"), "{err}");
     // A scene given with --resume must be the checkpoint's.
     let other = dir.join("other.toml");
-    std::fs::write(&other, SCENE.replace("END", "0.03")).unwrap();
+    std::fs::write(&other, scene_text().replace("END", "0.03")).unwrap();
     let out = talus(&[Path::new("run"), &other, Path::new("--resume"), &run])
         .output()
         .unwrap();
@@ -328,13 +295,7 @@ fn a_drum_interrupted_and_resumed_gives_the_same_outputs() {
 fn checkpoints_by_wall_clock_time() {
     let dir = scratch("resume_wall_clock");
     let scene = dir.join("scene.toml");
-    std::fs::write(
-        &scene,
-        SCENE
-            .replace("END", "0.01")
-            .replace("checkpoint_interval = 0.004\n", ""),
-    )
-    .unwrap();
+    std::fs::write(&scene, common::LID_BOX.replace("END", "0.01")).unwrap();
     let out = dir.join("out");
     let every = |minutes: &str| {
         talus(&[Path::new("run"), &scene, Path::new("--out"), &out])

@@ -5,48 +5,9 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-const SCENE: &str = r#"
-[simulation]
-dt = 2e-6
-end_time = END
-gravity = [0.0, 0.0, -9.81]
+mod common;
 
-[contact]
-regularisation = 0.2
-
-[output]
-frame_interval = 0.001
-
-[materials.pla]
-density = 1500.0
-young = 1e6
-poisson = 0.1
-restitution = 0.3
-friction = 0.5
-
-[shapes.dodecahedron]
-kind = "platonic"
-solid = "dodecahedron"
-circumradius = 0.005
-
-[[wall]]
-name = "box"
-material = "pla"
-geometry = { kind = "box", min = [0.0, 0.0, 0.0], max = [0.04, 0.04, 0.1], open_top = true }
-
-[[wall]]
-name = "lid"
-material = "pla"
-geometry = { kind = "plane", centre = [0.02, 0.02, 0.09], normal = [0.0, 0.0, -1.0], size = 0.04 }
-motion = { kind = "linear", velocity = [0.0, 0.0, -0.5] }
-
-[[particles]]
-kind = "lattice"
-shape = "dodecahedron"
-material = "pla"
-min = [0.0, 0.0, 0.0]
-max = [0.04, 0.04, 0.04]
-"#;
+use common::LID_BOX as SCENE;
 
 fn write_scene(dir: &Path, end: &str) -> PathBuf {
     std::fs::create_dir_all(dir).unwrap();

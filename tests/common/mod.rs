@@ -109,3 +109,48 @@ pub fn settle(
     }
     sim
 }
+
+/// 27 dodecahedra in an open box with a lid pressing down at 0.5 m/s: contacts from
+/// the start, a frame (and a row) every millisecond; `END` stands for the end time.
+pub const LID_BOX: &str = r#"
+[simulation]
+dt = 2e-6
+end_time = END
+gravity = [0.0, 0.0, -9.81]
+
+[contact]
+regularisation = 0.2
+
+[output]
+frame_interval = 0.001
+
+[materials.pla]
+density = 1500.0
+young = 1e6
+poisson = 0.1
+restitution = 0.3
+friction = 0.5
+
+[shapes.dodecahedron]
+kind = "platonic"
+solid = "dodecahedron"
+circumradius = 0.005
+
+[[wall]]
+name = "box"
+material = "pla"
+geometry = { kind = "box", min = [0.0, 0.0, 0.0], max = [0.04, 0.04, 0.1], open_top = true }
+
+[[wall]]
+name = "lid"
+material = "pla"
+geometry = { kind = "plane", centre = [0.02, 0.02, 0.09], normal = [0.0, 0.0, -1.0], size = 0.04 }
+motion = { kind = "linear", velocity = [0.0, 0.0, -0.5] }
+
+[[particles]]
+kind = "lattice"
+shape = "dodecahedron"
+material = "pla"
+min = [0.0, 0.0, 0.0]
+max = [0.04, 0.04, 0.04]
+"#;
