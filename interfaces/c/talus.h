@@ -53,6 +53,9 @@ int talus_initialize(talus_component *c, double start_time);
 int talus_step(talus_component *c, double t, double h);
 int talus_terminate(talus_component *c);
 int talus_time(talus_component *c, double *time);
+/* Warnings at the current parameters (a time step above the suggested one), one per
+ * line, "" when none; *text lives until the next call on c. */
+int talus_warnings(talus_component *c, const char **text);
 
 /* Walls by index. */
 int talus_wall_count(talus_component *c, size_t *count);

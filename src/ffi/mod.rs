@@ -34,6 +34,8 @@ fn set_error(message: &str) {
 pub struct TalusComponent {
     component: Component,
     saved: Vec<u8>,
+    /// The text `talus_warnings` hands out (kept until the next call).
+    warnings: std::ffi::CString,
 }
 
 /// Runs `f` on the handle: null checked, panics caught (the component then goes to
@@ -128,6 +130,7 @@ pub unsafe extern "C" fn talus_create(scene_path: *const c_char) -> *mut TalusCo
         Ok(component) => Box::into_raw(Box::new(TalusComponent {
             component,
             saved: Vec::new(),
+            warnings: std::ffi::CString::default(),
         })),
         Err(message) => {
             set_error(&message);
@@ -199,6 +202,24 @@ pub unsafe extern "C" fn talus_time(handle: *mut TalusComponent, time: *mut f64)
             .ok_or("the component is not initialised")?
             .time();
         unsafe { put(time, t, "time") }
+    })
+}
+
+/// What the user should know about the scene at the current parameters (a time step
+/// above the suggested one, as `talus check` says it), one warning per line; "" when
+/// there is none. The text lives until the next call on the component.
+///
+/// # Safety
+/// `handle` is a live component, `text` writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn talus_warnings(
+    handle: *mut TalusComponent,
+    text: *mut *const c_char,
+) -> c_int {
+    with(handle, |c| {
+        let joined = c.component.warnings().join("\n").replace('\0', " ");
+        c.warnings = std::ffi::CString::new(joined).map_err(|e| e.to_string())?;
+        unsafe { put(text, c.warnings.as_ptr(), "text") }
     })
 }
 
@@ -518,6 +539,32 @@ mod tests {
         let h = unsafe { talus_create(path.as_ptr().cast()) };
         assert!(!h.is_null());
         h
+    }
+
+    #[test]
+    fn warnings_follow_the_time_step_parameter() {
+        let h = drum();
+        let mut text: *const c_char = std::ptr::null();
+        assert_eq!(unsafe { talus_warnings(h, &mut text) }, TALUS_OK);
+        assert_eq!(unsafe { std::ffi::CStr::from_ptr(text) }.to_bytes(), b"");
+        let dt = [5e-3];
+        let name = c"dt";
+        assert_eq!(
+            unsafe { talus_set_real(h, name.as_ptr(), dt.as_ptr(), 1) },
+            TALUS_OK
+        );
+        assert_eq!(unsafe { talus_warnings(h, &mut text) }, TALUS_OK);
+        let warning = unsafe { std::ffi::CStr::from_ptr(text) }.to_string_lossy();
+        assert!(warning.contains("above the suggested"), "{warning}");
+        assert_eq!(
+            unsafe { talus_warnings(h, std::ptr::null_mut()) },
+            TALUS_ERROR
+        );
+        assert_eq!(
+            unsafe { talus_warnings(std::ptr::null_mut(), &mut text) },
+            TALUS_ERROR
+        );
+        unsafe { talus_free(h) };
     }
 
     #[test]
