@@ -102,7 +102,7 @@ int main(int argc, char **argv) {
     uint8_t garbage[64];
     memset(garbage, 7, sizeof garbage);
     REFUSED(talus_restore_state(c, garbage, sizeof garbage), "not a talus state");
-    REFUSED(talus_restore_state(c, copy, size / 2), "corrupt");
+    REFUSED(talus_restore_state(c, copy, size / 2), "damaged");
 
     double ke = -1.0;
     CHECK(talus_get_real(c, "kinetic_energy", &ke, 1) == TALUS_OK && ke > 0.0, "kinetic energy");
