@@ -13,9 +13,9 @@ threads of this process are sampled every 10 s.
 the threads of the server are sampled every 10 s.
 
 Prints, and writes to --out, the samples (elapsed s, RSS MiB, threads, simulated s,
-steps), then a summary line: RSS after the first minute and at the end, the largest,
-and the thread counts seen. Exit status 1 when the RSS grew by more than 10 % after
-the first minute or the thread count changed.
+steps), then a summary line: RSS after the first minute (warm-up) and at the end, the
+largest after it, and the thread counts seen after it. Exit status 1 when the RSS grew
+by more than 10 % after the first minute or the thread count changed.
 """
 import argparse
 import csv
@@ -135,9 +135,11 @@ def main():
             w = csv.writer(f)
             w.writerow(["elapsed_s", "rss_mib", "threads", "simulated_s", "steps"])
             w.writerows(rows)
+    # The first minute is warm-up (the server starting, the first connection).
     after_minute = next((r for r in rows if r[0] >= 60), rows[-1])
-    peak = max(r[1] for r in rows)
-    threads = sorted({r[2] for r in rows})
+    steady = [r for r in rows if r[0] >= after_minute[0]]
+    peak = max(r[1] for r in steady)
+    threads = sorted({r[2] for r in steady})
     growth = rows[-1][1] / after_minute[1] - 1
     print(f"{args.mode}: {rows[-1][0] / 60:.1f} min, {rows[-1][4]} steps, {rows[-1][3]:.1f} s "
           f"simulated; RSS {after_minute[1]:.1f} MiB after 1 min, {rows[-1][1]:.1f} MiB at the "
