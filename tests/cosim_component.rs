@@ -585,3 +585,33 @@ fn a_step_of_more_than_1e8_dem_steps_is_refused() {
     assert!(err.to_string().contains("at most 1e8"), "{err}");
     assert_eq!(time(&c), 0.0);
 }
+
+#[test]
+fn a_state_with_a_bad_step_or_non_finite_values_is_refused_even_with_its_checksum() {
+    // Found by fuzzing: bytes whose checksum was made right after changing them. A
+    // negative time step made the next do_step loop for ever; a NaN position would
+    // poison every step after it.
+    let mut c = started("drum.toml");
+    c.do_step(0.0, 0.01).unwrap();
+    let bytes = c.state_to_bytes(&c.save_state().unwrap());
+    let rewritten = |at: usize, value: f64| {
+        let mut body = bytes[..bytes.len() - 4].to_vec();
+        body[at..at + 8].copy_from_slice(&value.to_le_bytes());
+        let crc = talus::checksum::crc32(&body);
+        body.extend_from_slice(&crc.to_le_bytes());
+        body
+    };
+    // Layout: magic, fingerprint, time (16), dt (24), ...; the first particle's id
+    // (88), body type (96), position (104).
+    for (at, value, words) in [
+        (24, -1e-4, "time step"),
+        (24, 0.0, "time step"),
+        (24, f64::NAN, "time step"),
+        (16, f64::INFINITY, "time"),
+        (104, f64::NAN, "non-finite"),
+    ] {
+        let err = c.state_from_bytes(&rewritten(at, value)).unwrap_err();
+        assert!(err.to_string().contains(words), "{at}: {err}");
+    }
+    assert!(c.state_from_bytes(&rewritten(24, 2e-5)).is_ok());
+}
