@@ -246,8 +246,12 @@ pub fn state_bytes(data: &[u8]) {
                 Ok(state) => {
                     c.restore_state(&state)
                         .expect("a state that was read restores");
-                    let t = c.simulation().expect("running").time();
-                    let _ = c.do_step(t, 3e-4);
+                    let sim = c.simulation().expect("running");
+                    let (t, dt) = (sim.time(), sim.dt());
+                    // A state's own tiny step makes a long (legitimate) step: not here.
+                    if 3e-4 / dt <= 100.0 {
+                        let _ = c.do_step(t, 3e-4);
+                    }
                     c.restore_state(clean).expect("back to the clean state");
                 }
                 Err(_) => assert_eq!(observe(c), before, "a refused state changed the component"),
