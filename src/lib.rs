@@ -44,3 +44,6 @@ pub mod world;
 
 /// The scalar type used throughout talus.
 pub type Real = f64;
+
+/// The talus version (the crate's), as `talus --version` and the C API report it.
+pub const VERSION: &str = env!("CARGO_PKG_VERSION");

@@ -1,12 +1,36 @@
-//! The native C API: the header matches the exported functions, and a C program
-//! compiled against it drives a drum scene (results, misuse, rollback).
+//! The native C API: the header is cbindgen's and matches the exported functions,
+//! and a C program compiled against it drives a drum scene (results, misuse,
+//! rollback).
 
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+/// The generator of the header (its `main` writes the file).
+#[allow(dead_code)]
+#[path = "../examples/c_header.rs"]
+mod c_header;
+
 fn root() -> &'static Path {
     Path::new(env!("CARGO_MANIFEST_DIR"))
+}
+
+#[test]
+fn the_header_is_what_cbindgen_generates() {
+    let mut generated = Vec::new();
+    c_header::c_header(root()).write(&mut generated);
+    let committed = std::fs::read(root().join("interfaces/c/talus.h")).unwrap();
+    assert!(
+        generated == committed,
+        "interfaces/c/talus.h differs from what cbindgen generates from src/ffi/mod.rs: \
+         run `cargo run --example c_header` and commit the header"
+    );
+    // The doc comments came over.
+    let text = String::from_utf8(generated).unwrap();
+    assert!(
+        text.contains("// Advances from `t` (the current time) by `h`."),
+        "{text}"
+    );
 }
 
 /// Names `talus_*` followed by `(` in a text.

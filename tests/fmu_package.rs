@@ -6,20 +6,23 @@ use std::path::Path;
 use talus::fmi::description::FmiVersion;
 use talus::fmi::package::{PackageError, write_fmu};
 
-/// Entry names from a zip's central directory.
-fn entries(zip: &[u8]) -> Vec<String> {
-    let end = zip.len() - 22;
-    assert_eq!(&zip[end..end + 4], &0x0605_4b50u32.to_le_bytes());
-    let count = u16::from_le_bytes([zip[end + 10], zip[end + 11]]) as usize;
-    let mut at = u32::from_le_bytes(zip[end + 16..end + 20].try_into().unwrap()) as usize;
-    let mut names = Vec::new();
-    for _ in 0..count {
-        assert_eq!(&zip[at..at + 4], &0x0201_4b50u32.to_le_bytes());
-        let len = u16::from_le_bytes([zip[at + 28], zip[at + 29]]) as usize;
-        names.push(String::from_utf8(zip[at + 46..at + 46 + len].to_vec()).unwrap());
-        at += 46 + len;
-    }
-    names
+/// The archive's entries, each read back through the `zip` crate's reader (which
+/// checks every entry's CRC-32): name, contents, compression and Unix mode.
+fn entries(archive: &[u8]) -> Vec<(String, Vec<u8>, zip::CompressionMethod, Option<u32>)> {
+    let mut zip = zip::ZipArchive::new(std::io::Cursor::new(archive)).unwrap();
+    (0..zip.len())
+        .map(|k| {
+            let mut file = zip.by_index(k).unwrap();
+            let mut data = Vec::new();
+            std::io::Read::read_to_end(&mut file, &mut data).unwrap();
+            (
+                file.name().to_string(),
+                data,
+                file.compression(),
+                file.unix_mode(),
+            )
+        })
+        .collect()
 }
 
 fn root() -> &'static Path {
@@ -31,7 +34,9 @@ fn a_scene_with_a_wall_mesh_packs_its_mesh_and_the_library() {
     let dir = std::env::temp_dir().join(format!("talus-fmu-pack-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let library = dir.join("libfake.so");
-    std::fs::write(&library, b"not really a library").unwrap();
+    // Compressible, like a real library.
+    let fake: Vec<u8> = b"not really a library. ".repeat(4000);
+    std::fs::write(&library, &fake).unwrap();
     for (version, platform) in [
         (FmiVersion::Two, "linux64"),
         (FmiVersion::Three, "x86_64-linux"),
@@ -44,23 +49,50 @@ fn a_scene_with_a_wall_mesh_packs_its_mesh_and_the_library() {
             &out,
         )
         .unwrap();
-        let names = entries(&std::fs::read(&out).unwrap());
-        assert!(
-            names.contains(&"modelDescription.xml".to_string()),
-            "{names:?}"
+        let archive = std::fs::read(&out).unwrap();
+        let entries = entries(&archive);
+        let names: Vec<&str> = entries.iter().map(|e| e.0.as_str()).collect();
+        for name in [
+            "modelDescription.xml",
+            &format!("binaries/{platform}/talus.so"),
+            "resources/scene.toml",
+            "resources/floor.stl",
+        ] {
+            assert!(names.contains(&name), "{name} missing from {names:?}");
+        }
+        for (name, data, method, mode) in &entries {
+            assert_eq!(*method, zip::CompressionMethod::Deflated, "{name}");
+            let executable = name.ends_with(".so");
+            assert_eq!(
+                mode.map(|m| m & 0o777),
+                Some(if executable { 0o755 } else { 0o644 })
+            );
+            if executable {
+                assert_eq!(data, &fake, "the library comes back as packed");
+            }
+        }
+        let scene = &entries
+            .iter()
+            .find(|e| e.0 == "resources/scene.toml")
+            .unwrap()
+            .1;
+        assert_eq!(
+            scene,
+            &std::fs::read(root().join("examples/sliding_cuboid/scene.toml")).unwrap()
         );
-        assert!(
-            names.contains(&format!("binaries/{platform}/talus.so")),
-            "{names:?}"
-        );
-        assert!(
-            names.contains(&"resources/scene.toml".to_string()),
-            "{names:?}"
-        );
-        assert!(
-            names.contains(&"resources/floor.stl".to_string()),
-            "{names:?}"
-        );
+        // Deflated: the 88 kB library packs to a small fraction of itself.
+        assert!(archive.len() < fake.len() / 10, "{} bytes", archive.len());
+        assert_eq!(summary.bytes, archive.len());
+        // Packed again: the same bytes (no clock in the archive).
+        let again = dir.join("again.fmu");
+        write_fmu(
+            &root().join("examples/sliding_cuboid/scene.toml"),
+            &library,
+            version,
+            &again,
+        )
+        .unwrap();
+        assert!(std::fs::read(&again).unwrap() == archive);
         assert_eq!(summary.resources.len(), 2);
         assert!(summary.guid.starts_with('{') && summary.guid.len() == 38);
     }

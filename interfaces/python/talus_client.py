@@ -10,10 +10,11 @@
 (`talus proto --python-out DIR`). Needs eclipse-zenoh and protobuf
 (interfaces/python/requirements.txt).
 """
-import importlib
+import importlib.util
 import json
 import sys
 import time
+from pathlib import Path
 
 import zenoh
 
@@ -22,14 +23,24 @@ class TalusError(RuntimeError):
     """A request the node answered with an error status."""
 
 
+_MODULE = "talus_v1_talus_pb2"
+
+
 def _messages(proto_dir):
-    if proto_dir is not None and str(proto_dir) not in sys.path:
-        sys.path.insert(0, str(proto_dir))
-    try:
-        return importlib.import_module("talus.v1.talus_pb2")
-    except ImportError as e:
-        raise ImportError("generate the message classes first: talus proto --python-out DIR, "
-                          "and pass proto_dir=DIR") from e
+    """The message classes generated into `proto_dir` (talus/v1/talus_pb2.py), loaded
+    from their file: the `talus` Python package, when installed, owns the name
+    `talus`, so they cannot be imported as `talus.v1.talus_pb2`."""
+    if _MODULE in sys.modules:
+        return sys.modules[_MODULE]
+    path = Path(proto_dir or ".") / "talus" / "v1" / "talus_pb2.py"
+    if not path.is_file():
+        raise ImportError(f"no {path}: generate the message classes first with "
+                          "talus proto --python-out DIR, and pass proto_dir=DIR")
+    spec = importlib.util.spec_from_file_location(_MODULE, path)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[_MODULE] = module
+    spec.loader.exec_module(module)
+    return module
 
 
 class Client:

@@ -21,7 +21,6 @@ mod fmi2;
 mod fmi3;
 pub mod package;
 mod state;
-mod zip;
 
 use std::ffi::{CString, c_char, c_int, c_void};
 use std::path::PathBuf;

@@ -11,7 +11,6 @@ use std::path::{Component as PathPart, Path, PathBuf};
 use thiserror::Error;
 
 use super::description::{self, FmiVersion};
-use super::zip::write_zip;
 use super::{MODEL_IDENTIFIER, SCENE_FILE, guid};
 use crate::cosim::{Component, CosimError};
 use crate::geometry::ShapeSpec;
@@ -167,8 +166,7 @@ pub fn write_fmu(
             .join("/");
         entries.push((format!("resources/{name}"), bytes.clone()));
     }
-    let mut archive = Vec::new();
-    write_zip(&mut archive, &entries).map_err(io(out))?;
+    let archive = zip_archive(&entries).map_err(io(out))?;
     std::fs::write(out, &archive).map_err(io(out))?;
     Ok(FmuSummary {
         guid: guid(component.fingerprint()),
@@ -176,4 +174,29 @@ pub fn write_fmu(
         resources: resources.into_iter().map(|r| r.0).collect(),
         bytes: archive.len(),
     })
+}
+
+/// `entries` (path inside the archive, contents) as a zip archive, every entry
+/// deflated; the shared library executable, the rest read-only for others. Entries
+/// carry the zip epoch (1980-01-01) as their time, so the same scene and library give
+/// the same bytes.
+fn zip_archive(entries: &[(String, Vec<u8>)]) -> std::io::Result<Vec<u8>> {
+    use std::io::Write;
+    use zip::write::SimpleFileOptions;
+
+    let mut zip = zip::ZipWriter::new(std::io::Cursor::new(Vec::new()));
+    for (name, data) in entries {
+        let mode = if name.ends_with(".so") { 0o755 } else { 0o644 };
+        let options = SimpleFileOptions::default()
+            .compression_method(zip::CompressionMethod::Deflated)
+            .last_modified_time(zip::DateTime::default())
+            .unix_permissions(mode)
+            // Libraries past 4 GiB are not expected, but zip64 costs nothing when
+            // not needed.
+            .large_file(data.len() as u64 >= u32::MAX as u64);
+        zip.start_file(name.as_str(), options)
+            .map_err(std::io::Error::other)?;
+        zip.write_all(data)?;
+    }
+    Ok(zip.finish().map_err(std::io::Error::other)?.into_inner())
 }

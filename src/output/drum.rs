@@ -9,9 +9,11 @@
 //!   repose;
 //! - `drum_field.csv` and `drum_field.png`: the time-averaged velocity field of the
 //!   central slice (cross-section coordinates `h` across, `v` up, about the axis);
-//!   the image colours the mean speed from 0 (dark blue) to the largest cell mean
-//!   (yellow), grey where no particle came, with the drum's rim in black and the mean
-//!   free surface in red;
+//!   the plot colours the mean speed (viridis, colour bar in m/s, axes in metres),
+//!   grey where no particle came, with the drum's rim in black and the mean free
+//!   surface in red;
+//! - `drum_torque.png`: the drive torque and the bed's gravitational moment of each
+//!   row of `drum.csv` against time;
 //! - `drum.json`: averages over the analysis window (see
 //!   [`crate::analysis::DrumSummary`]).
 
@@ -19,7 +21,9 @@ use std::fs::File;
 use std::io::{self, BufWriter, Write};
 use std::path::Path;
 
-use super::png::{Image, viridis};
+use plotters::style::RGBColor;
+
+use super::plot::{Cell, HeatMap, LineChart, Series};
 use crate::Real;
 use crate::analysis::{Drum, DrumMonitor, DrumRow, DrumSummary};
 use crate::world::World;
@@ -116,6 +120,7 @@ impl DrumOutput {
         }
         revs.flush()?;
         self.write_field(dir)?;
+        self.plot_torque(dir)?;
         let summary = self.monitor.summary(world);
         let text = serde_json::to_string_pretty(&summary).map_err(io::Error::other)?;
         std::fs::write(dir.join("drum.json"), text + "\n")?;
@@ -148,55 +153,110 @@ impl DrumOutput {
             )?;
         }
         csv.flush()?;
-        // The image: `scale` pixels per cell, v up.
-        let scale = (480 / field.n.max(1)).max(1);
-        let size = scale * field.n;
-        let mut image = Image::new(size, size);
-        let px_per_m = scale as Real / field.cell;
+        self.plot_field(&dir.join("drum_field.png"), top)
+    }
+
+    /// `drum_field.png`: the mean speed of each cell, the rim and the mean free
+    /// surface, in the cross-section's coordinates.
+    fn plot_field(&self, path: &Path, top: Real) -> io::Result<()> {
+        let field = self.monitor.field();
+        let half = 0.5 * field.cell;
+        let mut cells = Vec::new();
         for j in 0..field.n {
             for i in 0..field.n {
                 let c = field.cell(i, j);
                 let inside = c.centre[0].hypot(c.centre[1]) <= field.radius;
-                let colour = if c.count > 0 {
-                    viridis(c.velocity[0].hypot(c.velocity[1]) / top.max(Real::MIN_POSITIVE))
-                } else if inside {
-                    [210, 210, 210]
-                } else {
+                if c.count == 0 && !inside {
                     continue;
-                };
-                for dy in 0..scale {
-                    for dx in 0..scale {
-                        let x = (i * scale + dx) as i64;
-                        let y = ((field.n - 1 - j) * scale + dy) as i64;
-                        image.put(x, y, colour);
-                    }
                 }
+                cells.push(Cell {
+                    x: (c.centre[0] - half, c.centre[0] + half),
+                    y: (c.centre[1] - half, c.centre[1] + half),
+                    value: (c.count > 0).then(|| c.velocity[0].hypot(c.velocity[1])),
+                });
             }
         }
-        let to_pixel = |h: Real, v: Real| {
-            (
-                ((h + field.radius) * px_per_m).round() as i64,
-                (size as Real - (v + field.radius) * px_per_m).round() as i64,
-            )
+        let r = field.radius;
+        let rim = (0..=360)
+            .map(|k| {
+                let a = (k as Real).to_radians();
+                (r * a.cos(), r * a.sin())
+            })
+            .collect();
+        let mut overlays = vec![Series {
+            name: "drum wall".into(),
+            points: rim,
+            colour: RGBColor(0, 0, 0),
+        }];
+        // The line v = intercept + slope h between its two crossings of the rim (a
+        // mean of unsteady fits, as in a cataracting drum, may miss the drum).
+        let surface: Vec<(Real, Real)> = self.monitor.mean_surface().map_or(Vec::new(), |s| {
+            (0..=400)
+                .map(|k| {
+                    let h = -r + 2.0 * r * k as Real / 400.0;
+                    (h, s.intercept + s.slope * h)
+                })
+                .filter(|(h, v)| h.hypot(*v) < r)
+                .collect()
+        });
+        if surface.len() > 1 {
+            let points = surface;
+            overlays.push(Series {
+                name: "mean free surface".into(),
+                points,
+                colour: RGBColor(220, 30, 30),
+            });
+        }
+        let margin = 0.03 * r;
+        HeatMap {
+            title: format!(
+                "Drum: time-averaged particle speed, central slice (largest {top:.3} m/s)"
+            ),
+            x_label: "h, across the cross-section (m)".into(),
+            y_label: "v, up (m)".into(),
+            value_label: "mean speed (m/s)".into(),
+            extent: (-r - margin, r + margin),
+            cells,
+            overlays,
+        }
+        .write_png(path)
+    }
+
+    /// `drum_torque.png`: the drive torque and the bed's gravitational moment of each
+    /// row of `drum.csv` against time (read back from the file, so a resumed run
+    /// plots the whole run).
+    fn plot_torque(&mut self, dir: &Path) -> io::Result<()> {
+        self.csv.flush()?;
+        let text = std::fs::read_to_string(dir.join("drum.csv"))?;
+        let mut lines = text.lines();
+        let header: Vec<&str> = lines.next().unwrap_or("").split(',').collect();
+        let column = |name: &str| {
+            header
+                .iter()
+                .position(|h| *h == name)
+                .ok_or_else(|| io::Error::other(format!("drum.csv has no column {name}")))
         };
-        let steps = 8 * size;
-        for k in 0..steps {
-            let a = std::f64::consts::TAU * k as Real / steps as Real;
-            let (x, y) = to_pixel(field.radius * a.cos(), field.radius * a.sin());
-            image.put(x, y, [0, 0, 0]);
-        }
-        if let Some(s) = self.monitor.mean_surface() {
-            for k in 0..steps {
-                let h = -field.radius + 2.0 * field.radius * k as Real / steps as Real;
-                let v = s.intercept + s.slope * h;
-                if h.hypot(v) < field.radius {
-                    let (x, y) = to_pixel(h, v);
-                    image.put(x, y, [220, 30, 30]);
-                }
-            }
-        }
-        let mut png = BufWriter::new(File::create(dir.join("drum_field.png"))?);
-        image.write_png(&mut png)?;
-        png.flush()
+        let (t, drive, gravity) = (
+            column("time")?,
+            column("drive_torque")?,
+            column("gravity_moment")?,
+        );
+        let rows: Vec<Vec<Real>> = lines
+            .map(|l| {
+                l.split(',')
+                    .map(|x| x.parse().unwrap_or(Real::NAN))
+                    .collect()
+            })
+            .collect();
+        let at = |r: &[Real], k: usize| r.get(k).copied().unwrap_or(Real::NAN);
+        let curve = |k: usize| rows.iter().map(|r| (at(r, t), at(r, k))).collect();
+        LineChart::new(
+            "Drum: torque about the axis (mean over each output interval)",
+            "time (s)",
+            "torque (N m)",
+        )
+        .with("drive torque", curve(drive))
+        .with("gravitational moment of the bed", curve(gravity))
+        .write_png(&dir.join("drum_torque.png"))
     }
 }

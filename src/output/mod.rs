@@ -18,7 +18,7 @@
 
 pub mod drum;
 pub mod packing;
-pub mod png;
+pub mod plot;
 mod resume;
 pub mod vtk;
 

@@ -4,7 +4,9 @@
 //!   height, region, bed-averaged porosity with the quadrature's error estimate,
 //!   coordination and orientation distributions, both profiles);
 //! - `packing_radial.csv` (`r_inner,r_outer,porosity`) and `packing_axial.csv`
-//!   (`z_lower,z_upper,porosity`, heights above the tube's base);
+//!   (`z_lower,z_upper,porosity`, heights above the tube's base), and their plots
+//!   `packing_radial.png` (against the distance from the wall in particle diameters)
+//!   and `packing_axial.png`;
 //! - `poses.csv`: `id,kind,shape,x,y,z,qw,qx,qy,qz` per particle (the body frame's
 //!   pose: centroid and principal axes), which `talus analyze` reads back;
 //! - `bed.stl`: every particle's surface in place (spheres as 320-triangle
@@ -17,14 +19,18 @@ use std::path::Path;
 use nalgebra::{Point3, UnitQuaternion};
 
 use crate::Real;
+use plotters::chart::SeriesLabelPosition;
+
+use super::plot::LineChart;
 use crate::analysis::packing::Packing;
 use crate::geometry::Shape;
 use crate::geometry::generators::icosphere_mesh;
 use crate::geometry::mesh_io::write_stl;
 use crate::world::World;
 
-/// Writes `packing.json` and the two profile CSVs.
+/// Writes `packing.json`, the two profile CSVs and their plots.
 pub fn write_packing(dir: &Path, packing: &Packing) -> io::Result<()> {
+    plot_profiles(dir, packing)?;
     let text = serde_json::to_string_pretty(packing).map_err(io::Error::other)?;
     std::fs::write(dir.join("packing.json"), text + "\n")?;
     let radial = packing
@@ -45,6 +51,61 @@ pub fn write_packing(dir: &Path, packing: &Packing) -> io::Result<()> {
         "z_lower,z_upper,porosity",
         axial,
     )
+}
+
+/// `packing_radial.png` (porosity against the distance from the tube wall in particle
+/// diameters, the usual form of a wall-effect profile) and `packing_axial.png`
+/// (porosity against height), each with the bed-averaged porosity.
+fn plot_profiles(dir: &Path, packing: &Packing) -> io::Result<()> {
+    let d = packing.diameter;
+    let radial = packing
+        .radial
+        .iter()
+        .map(|b| {
+            (
+                (packing.tube_radius - 0.5 * (b.r_inner + b.r_outer)) / d,
+                b.porosity,
+            )
+        })
+        .collect::<Vec<_>>();
+    let axial = packing
+        .axial
+        .iter()
+        .map(|s| (0.5 * (s.z_lower + s.z_upper), s.porosity))
+        .collect::<Vec<_>>();
+    let average = format!("bed average {:.4}", packing.porosity);
+    let flat = |from: Real, to: Real| vec![(from, packing.porosity), (to, packing.porosity)];
+    let wall_distance = packing.tube_radius / d;
+    let mut chart = LineChart::new(
+        &format!(
+            "Radial porosity profile (D/d = {:.2}, {} particles)",
+            packing.tube_to_particle, packing.particles
+        ),
+        &format!(
+            "distance from the tube wall (particle diameters, d = {:.3} mm)",
+            1e3 * d
+        ),
+        "porosity (-)",
+    )
+    .with("porosity of the annular bin", radial)
+    .with(&average, flat(0.0, wall_distance));
+    chart.y_range = Some((0.0, 1.05));
+    chart.legend = SeriesLabelPosition::LowerRight;
+    chart.write_png(&dir.join("packing_radial.png"))?;
+    let [z0, z1] = packing.region;
+    let mut chart = LineChart::new(
+        &format!(
+            "Axial porosity profile (bed height {:.2} mm)",
+            1e3 * packing.bed_height
+        ),
+        "height above the tube base (m)",
+        "porosity (-)",
+    )
+    .with("porosity of the slice", axial)
+    .with(&format!("{average} (its region)"), flat(z0, z1));
+    chart.y_range = Some((0.0, 1.05));
+    chart.legend = SeriesLabelPosition::LowerRight;
+    chart.write_png(&dir.join("packing_axial.png"))
 }
 
 /// A profile as CSV: bin edges and porosity per row.

@@ -154,3 +154,43 @@ material = "pla"
 min = [0.0, 0.0, 0.0]
 max = [0.04, 0.04, 0.04]
 "#;
+
+/// A PNG file decoded to 8-bit RGB: what a person would see of a plot.
+pub struct Picture {
+    pub width: u32,
+    pub height: u32,
+    pub rgb: Vec<u8>,
+}
+
+impl Picture {
+    /// Reads an 8-bit RGB PNG.
+    pub fn read(path: &Path) -> Picture {
+        let file = std::fs::File::open(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        let mut reader = png::Decoder::new(std::io::BufReader::new(file))
+            .read_info()
+            .unwrap();
+        let mut rgb = vec![0; reader.output_buffer_size().unwrap()];
+        let info = reader.next_frame(&mut rgb).unwrap();
+        assert_eq!(info.color_type, png::ColorType::Rgb, "{}", path.display());
+        rgb.truncate(info.buffer_size());
+        Picture {
+            width: info.width,
+            height: info.height,
+            rgb,
+        }
+    }
+
+    /// Pixels within `tolerance` (per channel) of `colour` in the rows `rows`.
+    pub fn count(&self, colour: [u8; 3], tolerance: u8, rows: std::ops::Range<u32>) -> usize {
+        let row = 3 * self.width as usize;
+        self.rgb[rows.start as usize * row..rows.end.min(self.height) as usize * row]
+            .chunks_exact(3)
+            .filter(|p| (0..3).all(|c| p[c].abs_diff(colour[c]) <= tolerance))
+            .count()
+    }
+
+    /// Dark pixels (text, axes) in the rows `rows`.
+    pub fn dark(&self, rows: std::ops::Range<u32>) -> usize {
+        self.count([0, 0, 0], 90, rows)
+    }
+}

@@ -1,0 +1,109 @@
+//! Plots a person reads: every PNG talus writes, with a title, labelled axes in SI
+//! units, and a legend or colour bar where there is more than one thing to tell apart.
+//!
+//! `plotters` draws into an RGB buffer (its bitmap backend), its text is rasterised by
+//! `ab_glyph` in DejaVu Sans (embedded by the `dejavu` crate, so no system font or
+//! fontconfig is needed), and `png` encodes the buffer. Two kinds of figure cover what
+//! talus plots:
+//!
+//! - [`LineChart`]: curves against a common axis (drum torque over time, porosity
+//!   profiles);
+//! - [`HeatMap`]: a scalar on rectangular cells with a colour bar, and curves drawn over
+//!   it (the drum's velocity field with the rim and the free surface).
+
+mod chart;
+mod heat_map;
+
+use std::io;
+use std::path::Path;
+use std::sync::OnceLock;
+
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+pub use chart::{LineChart, Series};
+pub use heat_map::{Cell, HeatMap};
+
+/// The font family every text of a plot is set in.
+const FONT: &str = "sans-serif";
+
+/// The font family, registered with plotters on first use (DejaVu Sans).
+fn font() -> &'static str {
+    static REGISTERED: OnceLock<()> = OnceLock::new();
+    REGISTERED.get_or_init(|| {
+        // The embedded file is a valid TrueType font; a failure here is a build error
+        // of this crate, not something a user could cause.
+        plotters::style::register_font(FONT, FontStyle::Normal, dejavu::sans::regular())
+            .map_err(|_| ())
+            .expect("DejaVu Sans is a valid font");
+    });
+    FONT
+}
+
+/// A drawing area over an RGB buffer.
+type Area<'a> = DrawingArea<BitMapBackend<'a>, Shift>;
+
+/// Draws `draw` on a white canvas of `size` pixels and writes it to `path` as PNG
+/// (8-bit RGB).
+fn render(
+    path: &Path,
+    size: (u32, u32),
+    draw: impl FnOnce(&Area<'_>) -> Result<(), String>,
+) -> io::Result<()> {
+    let mut rgb = vec![255u8; 3 * size.0 as usize * size.1 as usize];
+    {
+        let area = BitMapBackend::with_buffer(&mut rgb, size).into_drawing_area();
+        draw(&area).map_err(io::Error::other)?;
+        area.present()
+            .map_err(|e| io::Error::other(e.to_string()))?;
+    }
+    write_png(path, size, &rgb)
+}
+
+/// Encodes an RGB buffer as PNG.
+fn write_png(path: &Path, (width, height): (u32, u32), rgb: &[u8]) -> io::Result<()> {
+    let file = io::BufWriter::new(std::fs::File::create(path)?);
+    let mut encoder = png::Encoder::new(file, width, height);
+    encoder.set_color(png::ColorType::Rgb);
+    encoder.set_depth(png::BitDepth::Eight);
+    let mut writer = encoder.write_header().map_err(io::Error::other)?;
+    writer.write_image_data(rgb).map_err(io::Error::other)?;
+    writer.finish().map_err(io::Error::other)
+}
+
+/// A plotters error as text.
+fn drawing<E: std::error::Error + Send + Sync>(e: DrawingAreaErrorKind<E>) -> String {
+    format!("drawing a plot: {e}")
+}
+
+/// `[lo, hi]` of finite values widened by 5 % on each side (and to a unit width when
+/// all values are equal), or `[0, 1]` when there is none.
+fn padded_range(values: impl Iterator<Item = f64>) -> (f64, f64) {
+    let (lo, hi) = values
+        .filter(|v| v.is_finite())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+            (lo.min(v), hi.max(v))
+        });
+    if lo > hi {
+        return (0.0, 1.0);
+    }
+    let pad = if hi > lo {
+        0.05 * (hi - lo)
+    } else {
+        0.5 * lo.abs().max(1e-12)
+    };
+    (lo - pad, hi + pad)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ranges_are_padded_and_never_empty() {
+        assert_eq!(padded_range([0.0, 10.0].into_iter()), (-0.5, 10.5));
+        assert_eq!(padded_range([2.0, 2.0].into_iter()), (1.0, 3.0));
+        assert_eq!(padded_range([f64::NAN].into_iter()), (0.0, 1.0));
+        assert_eq!(padded_range(std::iter::empty()), (0.0, 1.0));
+    }
+}
