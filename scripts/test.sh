@@ -6,17 +6,24 @@ cd "$(dirname "$0")/.."
 
 # The Rust toolchain is the machine's own; rustfmt and clippy come with it. Feature
 # sets built: default (no zenoh) and `zenoh` (the transport; its protoc is vendored).
+# The workspace's second member, python/, is the Python module (PyO3).
 echo "== format"
-cargo fmt --check
-echo "== clippy (default features, then --features zenoh)"
+cargo fmt --all --check
+echo "== clippy (default features, then --features zenoh, then the Python module)"
 cargo clippy --all-targets --locked -- -D warnings
 cargo clippy --all-targets --locked --features zenoh -- -D warnings
+cargo clippy -p talus-python --all-targets --locked -- -D warnings
 echo "== build (the talus program and libtalus.so, used by the C, FMU and zenoh tests)"
 cargo build --locked --features zenoh
 echo "== tests (--features zenoh: everything)"
 cargo test --locked --all-targets --features zenoh
 echo "== benchmarks build"
 cargo bench --locked --no-run
-echo "== Python tests (fmpy, zenoh client)"
+echo "== Python environment (fmpy, zenoh client, maturin)"
 scripts/python-env.sh tests/python/requirements.txt
+echo "== the Python module: an abi3 wheel built by maturin, installed into .venv"
+rm -rf target/wheels
+.venv/bin/maturin build --locked -m python/Cargo.toml --profile dev --strip --out target/wheels
+.venv/bin/pip install --quiet --force-reinstall --no-deps target/wheels/talus-*-abi3-*.whl
+echo "== Python tests (FMUs under fmpy, the zenoh client, the talus module)"
 .venv/bin/python -m pytest tests/python -q

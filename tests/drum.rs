@@ -8,6 +8,9 @@
 
 use std::path::{Path, PathBuf};
 
+mod common;
+use common::Picture;
+
 use talus::Real;
 use talus::analysis::Drum;
 use talus::scene::{Scene, Simulation};
@@ -325,8 +328,36 @@ fn a_run_writes_the_drum_files() {
         let d: Vec<&str> = d.split(',').collect();
         assert_eq!((w[1], w[0]), (d[3], d[4]));
     }
-    let png = std::fs::read(out.join("drum_field.png")).unwrap();
-    assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
+    // The plots, as a person sees them: a title (text in the top strip), the field's
+    // cells in viridis with both ends of the colour bar, the grey of cells no
+    // particle reached, the black rim; the torque curves in their colours.
+    let field = Picture::read(&out.join("drum_field.png"));
+    assert_eq!((field.width, field.height), (822, 684));
+    assert!(field.dark(0..44) > 300, "a title");
+    let body = 44..684;
+    assert!(
+        field.count([68, 1, 84], 2, body.clone()) > 100,
+        "the bar's low end"
+    );
+    assert!(
+        field.count([254, 232, 37], 2, body.clone()) > 100,
+        "the bar's high end"
+    );
+    assert!(
+        field.count([215, 215, 215], 0, body.clone()) > 1000,
+        "empty cells"
+    );
+    assert!(field.dark(body) > 3000, "rim, axes and labels");
+    let torque = Picture::read(&out.join("drum_torque.png"));
+    assert_eq!((torque.width, torque.height), (800, 500));
+    assert!(
+        torque.count([31, 119, 180], 40, 40..450) > 300,
+        "the drive torque"
+    );
+    assert!(
+        torque.count([214, 39, 40], 40, 40..450) > 300,
+        "the gravitational moment"
+    );
     let field = std::fs::read_to_string(out.join("drum_field.csv")).unwrap();
     assert!(field.lines().count() > 10);
     let json: serde_json::Value =

@@ -6,6 +6,9 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+mod common;
+use common::Picture;
+
 use talus::analysis::packing::Bed;
 
 /// Spheres (d = 5 mm) poured at random into a tube of 20 mm (N = 4), settling
@@ -114,6 +117,21 @@ fn a_run_writes_the_packing_and_analyze_reproduces_it() {
         "60 icospheres of 320 triangles"
     );
     assert!(out.join("packing_radial.csv").exists() && out.join("packing_axial.csv").exists());
+    // Both profiles plotted: a title, the profile and the bed average in their
+    // colours.
+    for name in ["packing_radial.png", "packing_axial.png"] {
+        let plot = Picture::read(&out.join(name));
+        assert_eq!((plot.width, plot.height), (800, 500), "{name}");
+        assert!(plot.dark(0..40) > 300, "{name}: a title");
+        assert!(
+            plot.count([31, 119, 180], 40, 40..450) > 300,
+            "{name}: the profile"
+        );
+        assert!(
+            plot.count([214, 39, 40], 40, 40..450) > 200,
+            "{name}: the average"
+        );
+    }
     // `talus analyze` reads the run back: the same figures.
     std::fs::remove_file(out.join("packing.json")).unwrap();
     let again = talus(&dir, &["analyze", "out"]);

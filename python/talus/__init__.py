@@ -82,13 +82,16 @@ def run(scene, until=None, interval=None, progress=True, each=None):
     if span > 0 and not interval > 0:
         raise ValueError(f"interval must be positive, not {interval}")
     bar = _progress_bar(max(span, 0.0), progress)
+    start, shown = scene.time, 0.0
     try:
         # Steps land on the end exactly; the last one is shortened.
         while scene.time < end - 1e-12 * max(1.0, abs(end)):
-            before = scene.time
-            scene.step(min(interval, end - before))
+            scene.step(min(interval, end - scene.time))
             if bar is not None:
-                bar.update(scene.time - before)
+                # What is shown adds up to the time simulated, without drift.
+                step = (scene.time - start) - shown
+                shown += step
+                bar.update(step)
             if each is not None and each(scene) is False:
                 break
     finally:

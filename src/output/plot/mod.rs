@@ -99,6 +99,97 @@ fn padded_range(values: impl Iterator<Item = f64>) -> (f64, f64) {
 mod tests {
     use super::*;
 
+    /// An RGB PNG read back: (width, height, pixels).
+    fn read(path: &Path) -> (u32, u32, Vec<[u8; 3]>) {
+        let file = std::fs::File::open(path).unwrap();
+        let mut reader = png::Decoder::new(io::BufReader::new(file))
+            .read_info()
+            .unwrap();
+        let mut buf = vec![0; reader.output_buffer_size().unwrap()];
+        let info = reader.next_frame(&mut buf).unwrap();
+        let pixels = buf[..info.buffer_size()]
+            .chunks_exact(3)
+            .map(|p| [p[0], p[1], p[2]])
+            .collect();
+        (info.width, info.height, pixels)
+    }
+
+    fn scratch(name: &str) -> std::path::PathBuf {
+        std::env::temp_dir().join(format!("talus-plot-{}-{name}", std::process::id()))
+    }
+
+    #[test]
+    fn a_line_is_drawn_where_its_values_map_and_the_title_is_set_in_text() {
+        let path = scratch("line.png");
+        let mut chart = LineChart::new("A flat line", "x (m)", "y (-)")
+            .with("y = 0.25", vec![(0.0, 0.25), (1.0, 0.25)]);
+        chart.y_range = Some((0.0, 1.0));
+        chart.write_png(&path).unwrap();
+        let (width, height, pixels) = read(&path);
+        let _ = std::fs::remove_file(&path);
+        assert_eq!((width, height), (800, 500));
+        let blue = chart::PALETTE[0];
+        let rows: Vec<u32> = (0..pixels.len())
+            .filter(|&k| pixels[k] == [blue.0, blue.1, blue.2])
+            .map(|k| k as u32 / width)
+            .collect();
+        // A line 2 px wide spanning most of the plot's width, a quarter of the way up
+        // the plot area (its top below the title, its bottom above the x labels).
+        assert!(rows.len() > 2 * 500, "{} pixels of the line", rows.len());
+        let (lo, hi) = (rows.iter().min().unwrap(), rows.iter().max().unwrap());
+        assert!(hi - lo <= 3, "rows {lo}..{hi}");
+        let (top, bottom) = (12 + 30, 500 - 12 - 48);
+        let expected = bottom as f64 - 0.25 * (bottom - top) as f64;
+        assert!((*lo as f64 - expected).abs() < 15.0, "{lo} vs {expected}");
+        // Text: dark pixels in the title strip.
+        let dark = pixels[..40 * width as usize]
+            .iter()
+            .filter(|p| p.iter().all(|&c| c < 90))
+            .count();
+        assert!(dark > 100, "{dark} dark pixels in the title");
+    }
+
+    #[test]
+    fn a_heat_map_colours_its_cells_by_value_and_greys_the_empty_ones() {
+        let path = scratch("heat.png");
+        let cells = [(0.0, Some(0.0)), (1.0, Some(2.0)), (2.0, None)]
+            .into_iter()
+            .map(|(x, value)| Cell {
+                x: (x, x + 1.0),
+                y: (0.0, 3.0),
+                value,
+            })
+            .collect();
+        HeatMap {
+            title: "Three cells".into(),
+            x_label: "x (m)".into(),
+            y_label: "y (m)".into(),
+            value_label: "value (1)".into(),
+            extent: (0.0, 3.0),
+            cells,
+            overlays: Vec::new(),
+        }
+        .write_png(&path)
+        .unwrap();
+        let (_, _, pixels) = read(&path);
+        let _ = std::fs::remove_file(&path);
+        let count = |c: [u8; 3]| pixels.iter().filter(|p| **p == c).count();
+        // Each cell is a third of a ~540 px square plot: the low end of viridis (the
+        // cell at 0), its high end (the cell at the largest value) and grey.
+        let third = 540 * 540 / 3;
+        assert!(
+            count([68, 1, 84]) > third * 9 / 10,
+            "{}",
+            count([68, 1, 84])
+        );
+        assert!(
+            count([254, 232, 37]) > third * 9 / 10,
+            "{}",
+            count([254, 232, 37])
+        );
+        assert!(count([215, 215, 215]) > third * 9 / 10);
+    }
+
     #[test]
     fn ranges_are_padded_and_never_empty() {
         assert_eq!(padded_range([0.0, 10.0].into_iter()), (-0.5, 10.5));
