@@ -53,6 +53,9 @@ struct Scene {
     path: String,
 }
 
+/// Two vectors of 3 (a force and a torque).
+type Pair<'py> = (Bound<'py, PyArray1<Real>>, Bound<'py, PyArray1<Real>>);
+
 /// `n × 3` values as an `(n, 3)` array.
 fn rows3<'py>(py: Python<'py>, values: Vec<Real>) -> PyResult<Bound<'py, PyArray2<Real>>> {
     let n = values.len() / 3;
@@ -144,6 +147,18 @@ impl Scene {
             }
             c.set_real(&refs, &values).map_err(|e| e.to_string())
         })
+    }
+
+    /// The two wall outputs `wall.names[0]` and `wall.names[1]`.
+    fn wall_pair<'py>(
+        &self,
+        py: Python<'py>,
+        wall: &WallRef,
+        names: [&str; 2],
+    ) -> PyResult<Pair<'py>> {
+        let wall = self.wall_name(wall)?;
+        let [a, b] = names.map(|name| self.real(&format!("{wall}.{name}")));
+        Ok((a?.into_pyarray(py), b?.into_pyarray(py)))
     }
 
     /// `f` of the running simulation's world.
@@ -334,29 +349,13 @@ impl Scene {
 
     /// Mean force (N) and torque (N m) of the particles on a wall over the last step
     /// (impulse over the step): two arrays of 3.
-    #[allow(clippy::type_complexity)]
-    fn wall_force<'py>(
-        &self,
-        py: Python<'py>,
-        wall: WallRef,
-    ) -> PyResult<(Bound<'py, PyArray1<Real>>, Bound<'py, PyArray1<Real>>)> {
-        let name = self.wall_name(&wall)?;
-        let f = self.real(&format!("{name}.force"))?;
-        let t = self.real(&format!("{name}.torque"))?;
-        Ok((f.into_pyarray(py), t.into_pyarray(py)))
+    fn wall_force<'py>(&self, py: Python<'py>, wall: WallRef) -> PyResult<Pair<'py>> {
+        self.wall_pair(py, &wall, ["force", "torque"])
     }
 
     /// Force and torque on a wall at the end of the last step.
-    #[allow(clippy::type_complexity)]
-    fn wall_force_end<'py>(
-        &self,
-        py: Python<'py>,
-        wall: WallRef,
-    ) -> PyResult<(Bound<'py, PyArray1<Real>>, Bound<'py, PyArray1<Real>>)> {
-        let name = self.wall_name(&wall)?;
-        let f = self.real(&format!("{name}.force_end"))?;
-        let t = self.real(&format!("{name}.torque_end"))?;
-        Ok((f.into_pyarray(py), t.into_pyarray(py)))
+    fn wall_force_end<'py>(&self, py: Python<'py>, wall: WallRef) -> PyResult<Pair<'py>> {
+        self.wall_pair(py, &wall, ["force_end", "torque_end"])
     }
 
     /// Mean forces and torques on every wall over the last step: two `(walls, 3)`

@@ -181,3 +181,25 @@ def test_run_lands_on_the_end_with_progress_and_stops_when_asked(capsys):
     assert "0.02/0.02 s" in capsys.readouterr().err  # the span from 0.08 s
     with pytest.raises(ValueError):
         s.run(until=0.2, interval=-1.0, progress=False)
+
+
+def test_scenes_step_in_parallel_threads_as_they_do_alone():
+    """Steps release Python's lock: two scenes stepped from two threads at once give
+    the bits each gives alone."""
+    import threading
+
+    def torques(scene, out):
+        for _ in range(10):
+            scene.step(0.01)
+            out.extend(bits(scene.wall_force("drum")[1]))
+
+    alone = []
+    torques(spun_drum(), alone)
+    results = [[], []]
+    threads = [threading.Thread(target=torques, args=(spun_drum(), r)) for r in results]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join(timeout=120)
+    assert not any(t.is_alive() for t in threads)
+    assert results[0] == alone and results[1] == alone
