@@ -36,11 +36,9 @@ fn particle_energy(sim: &Simulation, n: usize) -> (Real, Real) {
     let p = &w.particles;
     let (mut kinetic, mut potential) = (0.0, 0.0);
     for i in 0..n.min(p.owned()) {
-        let t = &w.body_types[p.body_type[i] as usize];
-        let lb = p.orientation[i].inverse_transform_vector(&p.angular_momentum[i]);
-        kinetic += 0.5 * t.mass * p.velocity[i].norm_squared()
-            + 0.5 * lb.dot(&lb.component_div(&t.inertia));
-        potential -= t.mass * w.gravity.dot(&p.position[i].coords);
+        kinetic += w.particle_kinetic_energy(i);
+        let mass = w.body_types[p.body_type[i] as usize].mass;
+        potential -= mass * w.gravity.dot(&p.position[i].coords);
     }
     (kinetic, potential)
 }

@@ -340,15 +340,7 @@ impl Simulation {
     /// stable one).
     pub fn first_non_finite(&self) -> Option<u64> {
         let p = &self.world.particles;
-        let finite = |v: &[Real]| v.iter().all(|x| x.is_finite());
-        (0..p.owned())
-            .find(|&i| {
-                !(finite(p.position[i].coords.as_slice())
-                    && finite(p.velocity[i].as_slice())
-                    && finite(p.angular_momentum[i].as_slice())
-                    && finite(p.force[i].as_slice()))
-            })
-            .map(|i| p.id[i])
+        (0..p.owned()).find(|&i| !p.is_finite(i)).map(|i| p.id[i])
     }
 
     /// Whether the scene's settling criterion has held long enough.

@@ -176,14 +176,7 @@ impl Simulation {
                 p.id[i], p.body_type[i]
             ));
         }
-        let finite = |v: &[Real]| v.iter().all(|x| x.is_finite());
-        if let Some(i) = (0..p.len()).find(|&i| {
-            !(finite(p.position[i].coords.as_slice())
-                && finite(p.velocity[i].as_slice())
-                && finite(p.angular_momentum[i].as_slice())
-                && finite(p.force[i].as_slice())
-                && finite(p.torque[i].as_slice()))
-        }) {
+        if let Some(i) = (0..p.len()).find(|&i| !p.is_finite(i)) {
             return corrupt(format!(
                 "particle {} has a non-finite position, velocity or force",
                 p.id[i]

@@ -101,14 +101,17 @@ impl World {
 
     /// Total kinetic energy (translation and rotation) of the owned particles.
     pub fn kinetic_energy(&self) -> Real {
-        let p = &self.particles;
-        (0..p.owned())
-            .map(|i| {
-                let t = &self.body_types[p.body_type[i] as usize];
-                let lb = p.orientation[i].inverse_transform_vector(&p.angular_momentum[i]);
-                0.5 * t.mass * p.velocity[i].norm_squared()
-                    + 0.5 * lb.dot(&lb.component_div(&t.inertia))
-            })
+        (0..self.particles.owned())
+            .map(|i| self.particle_kinetic_energy(i))
             .sum()
+    }
+
+    /// Kinetic energy of particle `i`: translation and rotation (about its principal
+    /// axes, from the angular momentum).
+    pub fn particle_kinetic_energy(&self, i: usize) -> Real {
+        let p = &self.particles;
+        let t = &self.body_types[p.body_type[i] as usize];
+        let lb = p.orientation[i].inverse_transform_vector(&p.angular_momentum[i]);
+        0.5 * t.mass * p.velocity[i].norm_squared() + 0.5 * lb.dot(&lb.component_div(&t.inertia))
     }
 }

@@ -62,6 +62,17 @@ impl Particles {
         self.position.is_empty()
     }
 
+    /// Whether entry `i`'s position, velocity, angular momentum, force and torque are
+    /// all finite numbers.
+    pub fn is_finite(&self, i: usize) -> bool {
+        let finite = |v: &[Real]| v.iter().all(|x| x.is_finite());
+        finite(self.position[i].coords.as_slice())
+            && finite(self.velocity[i].as_slice())
+            && finite(self.angular_momentum[i].as_slice())
+            && finite(self.force[i].as_slice())
+            && finite(self.torque[i].as_slice())
+    }
+
     /// Number of owned particles: entries `0..owned()`.
     pub fn owned(&self) -> usize {
         self.len() - self.ghosts
