@@ -19,7 +19,7 @@ use pyo3::exceptions::PyException;
 use pyo3::prelude::*;
 use pyo3::types::PyBytes;
 use talus::Real;
-use talus::cosim::{Component, VarRef};
+use talus::cosim::Component;
 use talus::ffi::guard::catch;
 
 pyo3::create_exception!(
@@ -122,30 +122,22 @@ impl Scene {
     }
 
     /// Sets the two input variables `wall.suffix` of a wall driven from outside by
-    /// `kind`, all or none.
+    /// `kind`, all or none, as the C API does once the sizes are checked.
     fn set_wall_inputs(
         &mut self,
         wall: &WallRef,
         inputs: [(&str, Vec<Real>, usize); 2],
         kind: &str,
     ) -> PyResult<()> {
-        let name = self.wall_name(wall)?;
+        let wall = self.wall_index(wall)?;
         self.call(|c| {
-            let mut refs = Vec::new();
-            let mut values = Vec::new();
-            for (suffix, x, size) in inputs {
-                if x.len() != size {
+            for (suffix, x, size) in &inputs {
+                if x.len() != *size {
                     return Err(format!("{suffix}: {} values, expected {size}", x.len()));
                 }
-                let var = c
-                    .variable(&format!("{name}.{suffix}"))
-                    .map_err(|_| format!("wall '{name}' is not driven from outside by {kind}"))?;
-                for (element, value) in x.into_iter().enumerate() {
-                    refs.push(VarRef { var, element });
-                    values.push(value);
-                }
             }
-            c.set_real(&refs, &values).map_err(|e| e.to_string())
+            let [(a, x, _), (b, y, _)] = &inputs;
+            talus::ffi::set_wall_inputs(c, wall, [(a, x), (b, y)], kind)
         })
     }
 

@@ -82,8 +82,8 @@ fn var(c: &Component, name: &str) -> Result<usize, String> {
 }
 
 /// Sets the two input variables `wall.suffix` of a wall driven by `kind`, all or
-/// none.
-fn set_wall_inputs(
+/// none. Shared with the Python module, whose calls are these.
+pub fn set_wall_inputs(
     c: &mut Component,
     wall: usize,
     inputs: [(&str, &[f64]); 2],
