@@ -25,6 +25,8 @@ fn main() {
         poisson: 0.25,
         restitution: e,
         friction: mu,
+        rolling_friction: 0.0,
+        rolling_damping: 0.0,
     };
     let vertices = vec![
         Point3::new(-0.1, -0.1, 0.0),

@@ -42,6 +42,8 @@ fn main() {
         poisson: 0.25,
         restitution: 0.5,
         friction: 0.5,
+        rolling_friction: 0.0,
+        rolling_damping: 0.0,
     };
     let r = 0.005;
     let l = 0.06;

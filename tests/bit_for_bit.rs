@@ -32,7 +32,7 @@ const CASES: [Case; 3] = [
             0x9e67ff0815da3557,
             0xd6fa5b7a1076ff8d,
             0x22fa1b300583c2c0,
-            0xfeac5cecc9bfc733,
+            0xd5a066b81d8ee57a,
         ],
     },
     Case {
@@ -43,7 +43,7 @@ const CASES: [Case; 3] = [
             0x17ed34423bde0539,
             0xb65e1ed59af58ef2,
             0xee638a32aac71c74,
-            0xa8622961e6284b30,
+            0x6c78f59abd7df78f,
         ],
     },
     Case {
@@ -54,7 +54,7 @@ const CASES: [Case; 3] = [
             0xfc1c6885498302df,
             0xefc9884127a25b85,
             0x660383da9a42c070,
-            0xfc636242a47cea8e,
+            0x974b954bec797519,
         ],
     },
 ];

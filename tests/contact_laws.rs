@@ -207,7 +207,7 @@ fn coulomb_friction_sticks_slides_and_carries_its_history() {
     let spring = |v: Vector3<f64>| TangentialHistory {
         spring: v,
         stiffness: k,
-        twist: 0.0,
+        ..Default::default()
     };
     let t = tangential_force(
         &TangentialHistory::default(),

@@ -346,10 +346,7 @@ fn every_change_of_the_host_reaches_the_backend() {
     let scene = Scene::parse(&text, Path::new("box.toml")).unwrap();
     let calls = Calls::default();
     let backend = Recording {
-        inner: CpuBackend::new(StepParams {
-            regularisation_length: scene.spec.contact.regularisation,
-            skin: scene.spec.contact.skin,
-        }),
+        inner: CpuBackend::new(scene.step_params()),
         ids: Vec::new(),
         calls: calls.clone(),
     };

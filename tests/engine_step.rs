@@ -16,6 +16,8 @@ fn material(e: f64, friction: f64) -> Material {
         poisson: 0.25,
         restitution: e,
         friction,
+        rolling_friction: 0.0,
+        rolling_damping: 0.0,
     }
 }
 

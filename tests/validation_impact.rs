@@ -45,6 +45,8 @@ fn impact(theta_deg: f64, dt: f64) -> Outcome {
         poisson: 0.35,
         restitution: 0.85,
         friction: 0.0,
+        rolling_friction: 0.0,
+        rolling_damping: 0.0,
     };
     // A rigid wall: the pellet's modulus alone sets the contact (the seed's R → ∞ wall
     // of the same material is the other common choice; the impulse solution does not

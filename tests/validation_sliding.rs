@@ -71,6 +71,8 @@ fn sweep(lambda: f64) -> Vec<Vector3<f64>> {
         poisson: 0.1,
         restitution: 0.1,
         friction: 0.8,
+        rolling_friction: 0.0,
+        rolling_damping: 0.0,
     };
     let shape = Shape::Polyhedron(std::sync::Arc::new(
         generators::cuboid(EDGE, EDGE, EDGE).unwrap(),

@@ -38,6 +38,14 @@ pub struct Material {
     pub restitution: Real,
     /// Coulomb friction coefficient.
     pub friction: Real,
+    /// Rolling friction coefficient `μ_r` of the rolling-resistance models (the lever
+    /// arm of the resisting torque in units of the contact radius; 0: none).
+    #[serde(default)]
+    pub rolling_friction: Real,
+    /// Damping ratio `η_r` of the elastic–plastic rolling spring (Ai et al. 2011's
+    /// model C; 0: none).
+    #[serde(default)]
+    pub rolling_damping: Real,
 }
 
 impl Material {
@@ -83,6 +91,18 @@ impl Material {
             "friction",
             self.friction,
             self.friction.is_finite() && self.friction >= 0.0,
+            "must be non-negative",
+        )?;
+        check(
+            "rolling_friction",
+            self.rolling_friction,
+            self.rolling_friction.is_finite() && self.rolling_friction >= 0.0,
+            "must be non-negative",
+        )?;
+        check(
+            "rolling_damping",
+            self.rolling_damping,
+            self.rolling_damping.is_finite() && self.rolling_damping >= 0.0,
             "must be non-negative",
         )
     }
@@ -139,6 +159,8 @@ mod tests {
             poisson: 0.3,
             restitution: 0.8,
             friction: 0.4,
+            rolling_friction: 0.0,
+            rolling_damping: 0.0,
         }
     }
 

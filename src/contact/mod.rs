@@ -44,6 +44,12 @@
 //! dashpot on the tangential velocity, and the Coulomb cap `|F_t| ≤ μ |F_n|`; when
 //! sliding, the history is reset to the length that the cap allows.
 //!
+//! # Hertz–Mindlin for spheres
+//!
+//! Sphere scenes may choose the law of LIGGGHTS and EDEM instead (see
+//! `hertz_mindlin.rs`), with rolling resistance (`rolling.rs`); polyhedron pairs keep
+//! the volume law.
+//!
 //! # Rocking damping and twisting friction
 //!
 //! The normal dashpot and the friction force act at one point and cannot resist a
@@ -52,12 +58,16 @@
 
 mod area;
 mod damping;
+mod hertz_mindlin;
 mod material;
 mod normal;
+mod rolling;
 mod tangential;
 
 pub use area::{rocking_damping, twisting_friction};
 pub use damping::DampingTable;
+pub use hertz_mindlin::{HertzContact, HertzMindlinForce, HertzMindlinPair, hertz_mindlin_force};
 pub use material::{Material, MaterialError, PairStiffness};
 pub use normal::{NormalContact, NormalForce, normal_force};
+pub use rolling::{RollingContact, RollingModel, RollingParameters, rolling_torque};
 pub use tangential::{TangentialForce, TangentialHistory, tangential_force};

@@ -14,12 +14,15 @@ pub struct TangentialHistory {
     /// Accumulated relative twist about the normal, rad (see
     /// [`super::twisting_friction`]).
     pub twist: Real,
+    /// The elastic–plastic rolling spring's torque on body 2 (see
+    /// [`super::rolling_torque`]; zero under the other models).
+    pub rolling: Vector3<Real>,
 }
 
 impl TangentialHistory {
     /// Whether there is nothing to keep.
     pub fn is_empty(&self) -> bool {
-        self.spring == Vector3::zeros() && self.twist == 0.0
+        self.spring == Vector3::zeros() && self.twist == 0.0 && self.rolling == Vector3::zeros()
     }
 }
 
@@ -84,7 +87,7 @@ pub fn tangential_force(
             history: TangentialHistory {
                 spring,
                 stiffness,
-                twist: history.twist,
+                ..*history
             },
             sliding: false,
         };
@@ -105,7 +108,7 @@ pub fn tangential_force(
     let history = TangentialHistory {
         spring,
         stiffness,
-        twist: history.twist,
+        ..*history
     };
     TangentialForce {
         force,
@@ -126,7 +129,7 @@ mod tests {
         let mut h = TangentialHistory {
             spring: Vector3::new(1e-5, 0.0, 0.0),
             stiffness: 1e4,
-            twist: 0.0,
+            ..Default::default()
         };
         let energy = |h: &TangentialHistory| 0.5 * h.stiffness * h.spring.norm_squared();
         let start = energy(&h);

@@ -1,23 +1,25 @@
 //! Contact-law parameters the engine prepares before the contacts are evaluated.
 //!
-//! Every contact between two body types shares its stiffness, damping table,
-//! friction, regularisation volume and effective moment of inertia. They are
-//! gathered once per step into a table indexed by the two types, so that a contact
-//! reads them with one index instead of recomputing cube roots and hashing its
-//! restitution (measured: a tenth of the cost of a dense dodecahedron bed's step).
-//! The table is rebuilt every step (a handful of types makes it cheap), so that
-//! materials changed between steps take effect; the damping tables, whose
-//! calibration is the costly part, are kept for every restitution seen.
-
-use std::borrow::Cow;
+//! A contact's parameters combine what each body brings (its body type's stiffness per
+//! unit area `E/R` and `G/R`, regularisation volume, smallest moment of inertia) with
+//! what the pair of materials brings (damping table, friction, Hertz–Mindlin moduli).
+//! They are gathered into one row per body type and one per pair of materials, and a
+//! contact combines two rows in a few flops ([`ContactLaws::pair`]): the preparation
+//! costs O(types + materials²) per step and a contact O(1), whatever the number of
+//! distinct shapes (a table per pair of body types cost O(types²), most of a step of
+//! a bed of a thousand shapes). The combinations are the operations the laws define
+//! (`E₁/R₁ + E₂/R₂`, `1/(1/I₁ + 1/I₂)`, the smaller `(l R)³`), so the values are bit for
+//! bit those of a per-pair table. The rows are rebuilt every step, so that materials
+//! changed between steps take effect; the damping tables, whose calibration is the
+//! costly part, are kept for every restitution seen.
 
 use super::fast_hash::FastMap;
 use crate::Real;
-use crate::contact::{DampingTable, PairStiffness};
+use crate::contact::{DampingTable, HertzMindlinPair, PairStiffness, RollingParameters};
 use crate::world::World;
 
 /// Restitution of a pair of materials: the mean of the two.
-pub(super) fn pair_restitution(a: Real, b: Real) -> Real {
+fn pair_restitution(a: Real, b: Real) -> Real {
     0.5 * (a + b)
 }
 
@@ -35,46 +37,95 @@ pub(super) struct PairLaw {
     pub inertia: Real,
 }
 
-/// Damping tables per restitution and the [`PairLaw`] of every pair of body types.
+/// One body type's share of its contacts' parameters.
+#[derive(Clone, Copy, Debug)]
+struct TypeRow {
+    /// `E/R` and `G/R` (R the volume-equivalent radius).
+    stiffness: PairStiffness,
+    /// `(l R)³`: the regularisation volume of a contact in which this type is the
+    /// smaller body.
+    regularisation: Real,
+    /// Smallest principal moment of inertia `I_min`, and its inverse.
+    inertia: Real,
+    inverse_inertia: Real,
+    /// Volume-equivalent radius.
+    radius: Real,
+    material: usize,
+}
+
+/// One pair of materials' share of its contacts' parameters (walls included).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct MaterialPair {
+    /// Index of the pair's damping table.
+    table: usize,
+    /// Coulomb friction coefficient (the mean of the materials').
+    pub friction: Real,
+    /// `2 E₁E₂/(E₁ + E₂)` and the same of the shear moduli: a particle's moduli in
+    /// series with a wall's, times the two of a flat wall (see
+    /// [`PairStiffness::particle_wall`]).
+    wall_series: PairStiffness,
+    /// Moduli and damping of the Hertz–Mindlin law.
+    pub hertz: HertzMindlinPair,
+    /// Rolling resistance (means of the materials').
+    pub rolling: RollingParameters,
+}
+
+/// Damping tables per restitution, and the rows a contact's parameters are combined
+/// from.
 #[derive(Clone, Debug, Default)]
 pub(super) struct ContactLaws {
     /// Calibrated damping, one table per restitution value.
     tables: Vec<DampingTable>,
-    /// Index into `tables` by the restitution's bit pattern (looked up per wall
-    /// contact every step).
+    /// Index into `tables` by the restitution's bit pattern.
     table_of: FastMap<u64, usize>,
-    /// Row-major over (type of body 1, type of body 2).
-    pairs: Vec<PairLaw>,
-    types: usize,
+    /// One row per body type.
+    types: Vec<TypeRow>,
+    /// Row-major over (material 1, material 2).
+    materials: Vec<MaterialPair>,
+    material_count: usize,
 }
 
 impl ContactLaws {
-    /// Prepares the tables for `world`'s materials and body types; `regularisation_length`
+    /// Prepares the rows for `world`'s materials and body types; `regularisation_length`
     /// is relative to the smaller equivalent radius of a pair (see
     /// [`crate::contact::normal_force`]).
     pub(super) fn prepare(&mut self, world: &World, regularisation_length: Real) {
-        for a in &world.materials {
-            for b in &world.materials {
-                self.table_index(pair_restitution(a.restitution, b.restitution));
-            }
-        }
-        let types = &world.body_types;
-        self.types = types.len();
-        self.pairs.clear();
-        for ti in types {
-            for tj in types {
-                let (mi, mj) = (&world.materials[ti.material], &world.materials[tj.material]);
-                let (ri, rj) = (ti.shape.equivalent_radius(), tj.shape.equivalent_radius());
-                let e = pair_restitution(mi.restitution, mj.restitution);
-                self.pairs.push(PairLaw {
-                    stiffness: PairStiffness::particles(mi, ri, mj, rj),
-                    table: self.table_of[&e.to_bits()],
-                    friction: 0.5 * (mi.friction + mj.friction),
-                    regularisation: (regularisation_length * ri.min(rj)).powi(3),
-                    inertia: 1.0 / (1.0 / ti.inertia.min() + 1.0 / tj.inertia.min()),
+        let materials = &world.materials;
+        self.material_count = materials.len();
+        self.materials.clear();
+        for a in materials {
+            for b in materials {
+                let e = pair_restitution(a.restitution, b.restitution);
+                let table = self.table_index(e);
+                let series = |x: Real, y: Real| x * y / (x + y);
+                self.materials.push(MaterialPair {
+                    table,
+                    friction: 0.5 * (a.friction + b.friction),
+                    wall_series: PairStiffness {
+                        normal: 2.0 * series(a.young, b.young),
+                        tangential: 2.0 * series(a.shear_modulus(), b.shear_modulus()),
+                    },
+                    hertz: HertzMindlinPair::new(a, b, e),
+                    rolling: RollingParameters::mean(a, b),
                 });
             }
         }
+        self.types.clear();
+        self.types.extend(world.body_types.iter().map(|t| {
+            let m = &materials[t.material];
+            let radius = t.shape.equivalent_radius();
+            TypeRow {
+                stiffness: PairStiffness {
+                    normal: m.young / radius,
+                    tangential: m.shear_modulus() / radius,
+                },
+                regularisation: (regularisation_length * radius).powi(3),
+                inertia: t.inertia.min(),
+                inverse_inertia: 1.0 / t.inertia.min(),
+                radius,
+                material: t.material,
+            }
+        }));
     }
 
     fn table_index(&mut self, e: Real) -> usize {
@@ -84,10 +135,44 @@ impl ContactLaws {
         })
     }
 
+    /// The materials' share of a contact between materials `a` and `b`.
+    #[inline]
+    pub(super) fn materials(&self, a: usize, b: usize) -> &MaterialPair {
+        &self.materials[a * self.material_count + b]
+    }
+
     /// The law of a contact between body types `a` and `b`.
     #[inline]
-    pub(super) fn pair(&self, a: u32, b: u32) -> &PairLaw {
-        &self.pairs[a as usize * self.types + b as usize]
+    pub(super) fn pair(&self, a: u32, b: u32) -> PairLaw {
+        let (ta, tb) = (&self.types[a as usize], &self.types[b as usize]);
+        let m = self.materials(ta.material, tb.material);
+        PairLaw {
+            stiffness: PairStiffness {
+                normal: ta.stiffness.normal + tb.stiffness.normal,
+                tangential: ta.stiffness.tangential + tb.stiffness.tangential,
+            },
+            table: m.table,
+            friction: m.friction,
+            regularisation: ta.regularisation.min(tb.regularisation),
+            inertia: 1.0 / (ta.inverse_inertia + tb.inverse_inertia),
+        }
+    }
+
+    /// The law of a contact between body type `t` and a wall of material `wall`.
+    #[inline]
+    pub(super) fn wall(&self, t: u32, wall: usize) -> PairLaw {
+        let row = &self.types[t as usize];
+        let m = self.materials(row.material, wall);
+        PairLaw {
+            stiffness: PairStiffness {
+                normal: m.wall_series.normal / row.radius,
+                tangential: m.wall_series.tangential / row.radius,
+            },
+            table: m.table,
+            friction: m.friction,
+            regularisation: row.regularisation,
+            inertia: row.inertia,
+        }
     }
 
     /// The damping table of `law`.
@@ -95,13 +180,73 @@ impl ContactLaws {
     pub(super) fn damping(&self, law: &PairLaw) -> &DampingTable {
         &self.tables[law.table]
     }
+}
 
-    /// The calibrated damping of restitution `e`: borrowed when prepared, calibrated
-    /// afresh otherwise.
-    pub(super) fn damping_of(&self, e: Real) -> Cow<'_, DampingTable> {
-        match self.table_of.get(&e.to_bits()) {
-            Some(&k) => Cow::Borrowed(&self.tables[k]),
-            None => Cow::Owned(DampingTable::new(e)),
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::contact::Material;
+    use crate::geometry::{Shape, Sphere, generators};
+    use crate::world::BodyType;
+
+    fn material(young: Real, restitution: Real, friction: Real) -> Material {
+        Material {
+            name: format!("m{young}"),
+            density: 2000.0,
+            young,
+            poisson: 0.25,
+            restitution,
+            friction,
+            rolling_friction: 0.0,
+            rolling_damping: 0.0,
+        }
+    }
+
+    /// The combined rows give the per-pair values of the laws' definitions, bit for
+    /// bit (what a table per pair of body types held).
+    #[test]
+    fn combined_rows_equal_the_pair_definitions() {
+        let mut world = World {
+            materials: vec![material(1e7, 0.5, 0.3), material(3e8, 0.9, 0.6)],
+            ..Default::default()
+        };
+        let shapes = [
+            Shape::Sphere(Sphere::new(0.004).unwrap()),
+            Shape::Polyhedron(generators::cuboid(0.01, 0.02, 0.005).unwrap().into()),
+            Shape::Polyhedron(generators::random_convex(12, 0.007, 0.3, 5).unwrap().into()),
+        ];
+        for (k, s) in shapes.iter().enumerate() {
+            let m = k % 2;
+            world
+                .body_types
+                .push(BodyType::new(s.clone(), &world.materials[m], m));
+        }
+        let mut laws = ContactLaws::default();
+        let l = 0.05;
+        laws.prepare(&world, l);
+        for (i, a) in world.body_types.iter().enumerate() {
+            for (j, b) in world.body_types.iter().enumerate() {
+                let (ma, mb) = (&world.materials[a.material], &world.materials[b.material]);
+                let (ra, rb) = (a.shape.equivalent_radius(), b.shape.equivalent_radius());
+                let law = laws.pair(i as u32, j as u32);
+                assert_eq!(law.stiffness, PairStiffness::particles(ma, ra, mb, rb));
+                assert_eq!(law.friction, 0.5 * (ma.friction + mb.friction));
+                assert_eq!(law.regularisation, (l * ra.min(rb)).powi(3));
+                assert_eq!(
+                    law.inertia,
+                    1.0 / (1.0 / a.inertia.min() + 1.0 / b.inertia.min())
+                );
+                let e = 0.5 * (ma.restitution + mb.restitution);
+                assert_eq!(laws.damping(&law).restitution(), e);
+            }
+            for (w, wm) in world.materials.iter().enumerate() {
+                let law = laws.wall(i as u32, w);
+                let pm = &world.materials[a.material];
+                let r = a.shape.equivalent_radius();
+                assert_eq!(law.stiffness, PairStiffness::particle_wall(pm, r, wm));
+                assert_eq!(law.regularisation, (l * r).powi(3));
+                assert_eq!(law.friction, 0.5 * (pm.friction + wm.friction));
+            }
         }
     }
 }

@@ -24,5 +24,5 @@ pub mod time_step;
 
 pub use backend::{Backend, ContactHistory, WallKey};
 pub use cpu::CpuBackend;
-pub use params::{REGULARISATION_LENGTH, StepParams};
+pub use params::{REGULARISATION_LENGTH, RoundLaw, StepParams};
 pub use stats::{Stage, StageTimes, StepStats};

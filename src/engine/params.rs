@@ -1,6 +1,21 @@
 //! What a driver tells a backend about how to step, besides the step length.
 
 use crate::Real;
+use crate::contact::RollingModel;
+
+/// The law of contacts that involve a sphere (polyhedron pairs always follow the
+/// volume law).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum RoundLaw {
+    /// The volume law of every contact (see [`crate::contact::normal_force`]).
+    #[default]
+    Volume,
+    /// Hertz–Mindlin (see `contact/hertz_mindlin.rs`), with a rolling resistance.
+    HertzMindlin {
+        /// The rolling-resistance model.
+        rolling: RollingModel,
+    },
+}
 
 /// Default regularisation length: below this fraction of the smaller equivalent
 /// radius, cubed, the volume law is continued quadratically (see
@@ -17,6 +32,8 @@ pub struct StepParams {
     /// Skin of the neighbour lists; `None`: [`super::neighbours::DEFAULT_SKIN`] times
     /// the smallest bounding radius.
     pub skin: Option<Real>,
+    /// The law of contacts that involve a sphere.
+    pub round_law: RoundLaw,
 }
 
 impl Default for StepParams {
@@ -24,6 +41,7 @@ impl Default for StepParams {
         StepParams {
             regularisation_length: REGULARISATION_LENGTH,
             skin: None,
+            round_law: RoundLaw::Volume,
         }
     }
 }

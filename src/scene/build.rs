@@ -184,6 +184,8 @@ impl<'a> Builder<'a> {
                 poisson: m.poisson,
                 restitution: m.restitution,
                 friction: m.friction,
+                rolling_friction: m.rolling_friction,
+                rolling_damping: m.rolling_damping,
             };
             material.validate().map_err(|e| {
                 let crate::contact::MaterialError::Invalid { field, .. } = &e;

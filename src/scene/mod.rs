@@ -32,6 +32,7 @@ pub use state_bytes::{StateError, StateReader, StateWriter};
 use crate::Real;
 use crate::analysis::Drum;
 use crate::analysis::packing::Bed;
+use crate::engine::StepParams;
 use crate::engine::time_step::{TimeStepEstimate, suggested_time_step};
 use crate::world::{Inlet, World};
 
@@ -86,6 +87,16 @@ impl Scene {
         crate::checksum::fnv1a(text.as_bytes(), crate::checksum::FNV_OFFSET)
     }
 
+    /// The step parameters the scene's `[contact]` section asks for.
+    pub fn step_params(&self) -> StepParams {
+        let contact = &self.spec.contact;
+        StepParams {
+            regularisation_length: contact.regularisation,
+            skin: contact.skin,
+            round_law: contact.round_law(),
+        }
+    }
+
     /// Reads and validates a scene file.
     pub fn load(path: &Path) -> Result<Scene, SceneError> {
         let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
@@ -138,8 +149,16 @@ impl Scene {
                 format!("{skin} must be a non-negative length"),
             ));
         }
+        if spec.contact.rolling != crate::contact::RollingModel::None
+            && spec.contact.law != spec::ContactLawSpec::HertzMindlin
+        {
+            return Err(FieldError::new(
+                FieldPath::root("contact").key("rolling"),
+                "rolling resistance belongs to the Hertz–Mindlin law: set law = \"hertz_mindlin\"",
+            ));
+        }
         let built = build::Builder::new(&spec, &dir).build()?;
-        let suggested = suggested_time_step(&built.world, reg);
+        let suggested = suggested_time_step(&built.world, reg, spec.contact.round_law());
         let mut warnings = Vec::new();
         let dt = match (&sim.dt, &suggested) {
             (spec::TimeStepSpec::Fixed(dt), _) => {

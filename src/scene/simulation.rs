@@ -66,11 +66,7 @@ pub struct StepReport {
 impl Simulation {
     /// Starts a scene at time 0 (inlets insert what is due at 0) on the CPU backend.
     pub fn new(scene: &Scene) -> Self {
-        let params = StepParams {
-            regularisation_length: scene.spec.contact.regularisation,
-            skin: scene.spec.contact.skin,
-        };
-        Self::with_backend(scene, Box::new(CpuBackend::new(params)))
+        Self::with_backend(scene, Box::new(CpuBackend::new(scene.step_params())))
     }
 
     /// Starts a scene at time 0 on `backend`, and evaluates the first forces.

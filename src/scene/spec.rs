@@ -10,6 +10,8 @@ use std::path::PathBuf;
 use serde::{Deserialize, Serialize};
 
 use crate::Real;
+use crate::contact::RollingModel;
+use crate::engine::RoundLaw;
 use crate::geometry::ShapeSpec;
 use crate::world::{DriveInput, MotionKey};
 
@@ -211,6 +213,26 @@ pub struct ContactSpec {
     /// bounding radius): the lists are rebuilt once a particle has moved half of it.
     /// Results do not depend on it; only the cost does.
     pub skin: Option<Real>,
+    /// The law of contacts that involve a sphere: `"volume"` (default) or
+    /// `"hertz_mindlin"` (polyhedron pairs follow the volume law either way).
+    #[serde(default)]
+    pub law: ContactLawSpec,
+    /// Rolling resistance of Hertz–Mindlin contacts: `"none"` (default),
+    /// `"constant_torque"` or `"elastic_plastic"` (materials' `rolling_friction`,
+    /// `rolling_damping`).
+    #[serde(default)]
+    pub rolling: RollingModel,
+}
+
+/// `[contact] law`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ContactLawSpec {
+    /// The volume law for every contact.
+    #[default]
+    Volume,
+    /// Hertz–Mindlin for contacts that involve a sphere.
+    HertzMindlin,
 }
 
 impl Default for ContactSpec {
@@ -218,6 +240,20 @@ impl Default for ContactSpec {
         ContactSpec {
             regularisation: default_regularisation(),
             skin: None,
+            law: ContactLawSpec::Volume,
+            rolling: RollingModel::None,
+        }
+    }
+}
+
+impl ContactSpec {
+    /// The engine's law of contacts that involve a sphere.
+    pub fn round_law(&self) -> RoundLaw {
+        match self.law {
+            ContactLawSpec::Volume => RoundLaw::Volume,
+            ContactLawSpec::HertzMindlin => RoundLaw::HertzMindlin {
+                rolling: self.rolling,
+            },
         }
     }
 }
@@ -256,6 +292,13 @@ pub struct MaterialSpec {
     /// Coulomb friction coefficient.
     #[serde(default)]
     pub friction: Real,
+    /// Rolling friction coefficient of the rolling-resistance models (`[contact]
+    /// rolling`), default 0.
+    #[serde(default)]
+    pub rolling_friction: Real,
+    /// Damping ratio of the elastic–plastic rolling spring, default 0.
+    #[serde(default)]
+    pub rolling_damping: Real,
 }
 
 /// `[[wall]]`.

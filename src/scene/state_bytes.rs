@@ -27,8 +27,8 @@ use crate::engine::StepStats;
 use crate::world::Particles;
 
 /// The header of a state; the digit is the format's version (4: states in checked
-/// containers).
-pub const STATE_MAGIC: &[u8; 8] = b"TALUSST4";
+/// containers; 5: the rolling spring in the contact history).
+pub const STATE_MAGIC: &[u8; 8] = b"TALUSST5";
 
 /// Why bytes could not be restored as a state.
 #[derive(Debug, Error, PartialEq)]
@@ -225,6 +225,7 @@ fn write_history(w: &mut StateWriter, h: &TangentialHistory) {
     w.vec3(&h.spring);
     w.f64(h.stiffness);
     w.f64(h.twist);
+    w.vec3(&h.rolling);
 }
 
 fn read_history(r: &mut StateReader) -> Result<TangentialHistory, StateError> {
@@ -232,6 +233,7 @@ fn read_history(r: &mut StateReader) -> Result<TangentialHistory, StateError> {
         spring: r.vec3()?,
         stiffness: r.f64()?,
         twist: r.f64()?,
+        rolling: r.vec3()?,
     })
 }
 

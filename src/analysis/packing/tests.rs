@@ -14,6 +14,8 @@ fn world_of(shape: Shape, placements: &[(Point3<Real>, UnitQuaternion<Real>)]) -
         poisson: 0.3,
         restitution: 0.5,
         friction: 0.0,
+        rolling_friction: 0.0,
+        rolling_damping: 0.0,
     };
     let mut world = World {
         materials: vec![material.clone()],

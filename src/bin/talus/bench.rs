@@ -421,6 +421,61 @@ fn stage_line(stages: &[(&str, f64)]) -> String {
         .join(", ")
 }
 
+/// Scene (d): the lattice of random shapes with 20 body types, with a body type per
+/// particle of the same 20 shapes, and with every particle its own shape (see
+/// [`crate::bench_shapes`]), measured in turn on each thread count.
+fn many_shapes(dir: &Path, options: &BenchOptions) -> Result<()> {
+    let side = ((10_000.0 * options.scale).cbrt().round() as usize).max(2);
+    let count = side.pow(3);
+    let variants = [
+        (20, 20, "(d) 20 random shapes".to_string()),
+        (count, 20, format!("(d) {count} types of 20 shapes")),
+        (count, count, format!("(d) {count} random shapes")),
+    ];
+    let mut setups = Vec::new();
+    for (types, seeds, name) in variants {
+        let text = crate::bench_shapes::many_shapes(side, types, seeds, MATERIAL);
+        let setup = crate::bench_shapes::setup(&text, dir)?;
+        println!(
+            "{name}: setup {:.3} s (check with suggested step {:.3} s, first forces {:.3} s), \
+             {:.3} s per thousand body types",
+            setup.check + setup.first_step,
+            setup.check,
+            setup.first_step,
+            (setup.check + setup.first_step) / (types as f64 / 1000.0)
+        );
+        setups.push((name, setup));
+    }
+    for &threads in &options.threads {
+        let mut rates = Vec::new();
+        for (name, setup) in &setups {
+            let m = measure(&setup.scene, threads, 20, options.steps)?;
+            println!(
+                "{:<38} {:>7} {:>9} {:>10} {:>9.0} {:>8.1e} {:>16.3e} {:>14.3e} {:>10}",
+                name,
+                threads,
+                m.particles,
+                m.pairs,
+                m.contacts,
+                setup.scene.dt,
+                m.particle_steps,
+                m.contact_rate,
+                "-"
+            );
+            println!("{:<38} stages: {}", "", stage_line(&m.stages));
+            rates.push((m.particle_steps, m.contact_rate));
+        }
+        println!(
+            "(d) {threads} thread(s): {count} body types of 20 shapes step at {:.3} times the \
+             speed of 20 body types (same contacts); {count} random shapes at {:.3} times per \
+             contact",
+            rates[1].0 / rates[0].0,
+            rates[2].1 / rates[0].1
+        );
+    }
+    Ok(())
+}
+
 /// Options of `talus bench`.
 pub struct BenchOptions {
     /// Scale factor on the particle counts (1: 10 000 dodecahedra, 5000 spheres).
@@ -435,8 +490,8 @@ pub struct BenchOptions {
 
 /// `talus bench`.
 pub fn bench(options: BenchOptions) -> Result<()> {
-    if let Some(bad) = options.scenes.iter().find(|c| !"abc".contains(**c)) {
-        bail!("--scene {bad}: the scenes are a, b and c");
+    if let Some(bad) = options.scenes.iter().find(|c| !"abcd".contains(**c)) {
+        bail!("--scene {bad}: the scenes are a, b, c and d");
     }
     if options.threads.contains(&0) {
         bail!("--threads: a thread count is at least 1");
@@ -517,6 +572,9 @@ pub fn bench(options: BenchOptions) -> Result<()> {
             );
             println!("{:<38} stages: {}", "", stage_line(&m.stages));
         }
+    }
+    if wanted('d') {
+        many_shapes(&dir, &options)?;
     }
     println!(
         "dt: the suggested step of each scene; e error: |realised/requested − 1| of the \

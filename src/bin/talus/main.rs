@@ -2,6 +2,7 @@
 
 mod analyze;
 mod bench;
+mod bench_shapes;
 mod checkpoint;
 mod contact;
 mod fmu;

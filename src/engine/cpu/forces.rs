@@ -186,7 +186,7 @@ pub(super) fn pair_force(
     };
     let inputs = LawInputs {
         stiffness: law.stiffness,
-        damping: laws.damping(law),
+        damping: laws.damping(&law),
         friction: law.friction,
         regularisation: law.regularisation,
         dt,

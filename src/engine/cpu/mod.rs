@@ -16,6 +16,7 @@
 mod contact_state;
 mod dispatch;
 mod forces;
+mod hertz;
 mod motion;
 mod pairs;
 mod patch;
@@ -96,8 +97,11 @@ impl CpuBackend {
                 list,
                 contacts,
                 &work.radii,
-                laws,
-                dt,
+                pairs::PairLaws {
+                    laws,
+                    round: params.round_law,
+                    dt,
+                },
                 &mut work.results,
             )
         });
@@ -109,7 +113,7 @@ impl CpuBackend {
             let inputs = WallInputs {
                 list,
                 laws,
-                regularisation_length: params.regularisation_length,
+                round: params.round_law,
                 dt,
             };
             walls::wall_contacts(

@@ -6,15 +6,98 @@ use rayon::prelude::*;
 
 use super::contact_state::ContactState;
 use super::dispatch::pair_geometry;
-use super::forces::{ContactForce, pair_force};
+use super::forces::{ContactForce, RelativeMotion, inverse_mass_at, pair_force, velocity_at};
+use super::hertz::{
+    HertzInputs, effective_radius, rolling_inertia, round_contact_force, round_radius, sphere_pair,
+};
 use crate::Real;
+use crate::contact::TangentialHistory;
+use crate::engine::RoundLaw;
 use crate::engine::laws::ContactLaws;
 use crate::engine::neighbours::NeighbourList;
+use crate::geometry::Shape;
+use crate::geometry::overlap::OverlapCache;
 use crate::world::World;
 
 /// Smallest share of pairs and of particles one rayon task takes.
 const PAIRS_PER_TASK: usize = 64;
 const PARTICLES_PER_TASK: usize = 256;
+
+/// The laws of the pair stage.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct PairLaws<'a> {
+    pub laws: &'a ContactLaws,
+    pub round: RoundLaw,
+    pub dt: Real,
+}
+
+/// The contact of particles `i` and `j` whose bounding spheres overlap, under the
+/// scene's laws; `plan` is the pair's kept overlap plan.
+#[inline]
+fn pair_contact(
+    world: &World,
+    i: usize,
+    j: usize,
+    plan: &mut OverlapCache,
+    history: &TangentialHistory,
+    laws: &PairLaws,
+) -> Option<ContactForce> {
+    let p = &world.particles;
+    let (ti, tj) = (
+        &world.body_types[p.body_type[i] as usize],
+        &world.body_types[p.body_type[j] as usize],
+    );
+    let RoundLaw::HertzMindlin { rolling } = laws.round else {
+        return pair_geometry(world, i, j, plan)
+            .map(|g| pair_force(world, i, j, &g, *history, laws.laws, laws.dt));
+    };
+    let inputs = |radius, rolling_inertia| HertzInputs {
+        materials: laws.laws.materials(ti.material, tj.material),
+        rolling,
+        radius,
+        rolling_inertia,
+        dt: laws.dt,
+    };
+    match (&ti.shape, &tj.shape) {
+        (Shape::Polyhedron(_), Shape::Polyhedron(_)) => pair_geometry(world, i, j, plan)
+            .map(|g| pair_force(world, i, j, &g, *history, laws.laws, laws.dt)),
+        (Shape::Sphere(a), Shape::Sphere(b)) => {
+            let inertia =
+                1.0 / (1.0 / rolling_inertia(ti, a.radius) + 1.0 / rolling_inertia(tj, b.radius));
+            let law = inputs(effective_radius(a.radius, b.radius), inertia);
+            sphere_pair(world, (i, a.radius), (j, b.radius), law, history)
+        }
+        (si, sj) => {
+            // A sphere and a polyhedron: the polyhedron is locally flat.
+            let g = pair_geometry(world, i, j, plan)?;
+            let (wi, wj) = (world.angular_velocity(i), world.angular_velocity(j));
+            let motion = RelativeMotion {
+                velocity: velocity_at(world, j, &wj, &g.point)
+                    - velocity_at(world, i, &wi, &g.point),
+                spin: wj - wi,
+                inverse_mass: inverse_mass_at(world, i, &g.point, &g.normal)
+                    + inverse_mass_at(world, j, &g.point, &g.normal),
+                inertia: 0.0,
+            };
+            let lever = |k: usize| (g.point - p.position[k]).norm();
+            let inertia =
+                1.0 / (1.0 / rolling_inertia(ti, lever(i)) + 1.0 / rolling_inertia(tj, lever(j)));
+            let law = inputs(
+                effective_radius(round_radius(si), round_radius(sj)),
+                inertia,
+            );
+            Some(round_contact_force(
+                g.depth,
+                &g.normal,
+                &g.point,
+                &motion,
+                &law,
+                history,
+                &p.position[j],
+            ))
+        }
+    }
+}
 
 /// Evaluates every candidate pair into `results` (aligned with the pairs). Each
 /// pair's history is replaced by the one its contact leaves (empty when they do not
@@ -25,8 +108,7 @@ pub(super) fn pair_contacts(
     list: &NeighbourList,
     state: &mut ContactState,
     radii: &[Real],
-    laws: &ContactLaws,
-    dt: Real,
+    laws: PairLaws,
     results: &mut Vec<Option<ContactForce>>,
 ) {
     let p = &world.particles;
@@ -43,8 +125,7 @@ pub(super) fn pair_contacts(
                 let c = if !(p.is_passive(i) && p.is_passive(j))
                     && (p.position[j] - p.position[i]).norm_squared() < reach * reach
                 {
-                    pair_geometry(world, i, j, plan)
-                        .map(|g| pair_force(world, i, j, &g, *history, laws, dt))
+                    pair_contact(world, i, j, plan, history, &laws)
                 } else {
                     None
                 };

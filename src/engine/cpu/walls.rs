@@ -14,12 +14,14 @@ use super::dispatch::{facet_geometry, pose_of};
 use super::forces::{
     ContactForce, LawInputs, RelativeMotion, contact_force, inverse_mass_at, velocity_at,
 };
+use super::hertz::{HertzInputs, rolling_inertia, round_contact_force};
 use super::patch::{Merge, PatchSet, plane_key};
 use crate::Real;
-use crate::contact::{PairStiffness, TangentialHistory};
+use crate::contact::TangentialHistory;
+use crate::engine::RoundLaw;
 use crate::engine::backend::WallKey;
 use crate::engine::fast_hash::FastMap;
-use crate::engine::laws::{ContactLaws, pair_restitution};
+use crate::engine::laws::ContactLaws;
 use crate::engine::neighbours::NeighbourList;
 use crate::geometry::Shape;
 use crate::world::World;
@@ -54,8 +56,8 @@ pub(super) struct WallChunk {
 pub(super) struct WallInputs<'a> {
     pub list: &'a NeighbourList,
     pub laws: &'a ContactLaws,
-    /// Relative to the particle's equivalent radius (see [`crate::engine::StepParams`]).
-    pub regularisation_length: Real,
+    /// The law of a sphere's contacts.
+    pub round: RoundLaw,
     pub dt: Real,
 }
 
@@ -150,7 +152,7 @@ fn particle_contacts(
     let WallInputs {
         list,
         laws,
-        regularisation_length,
+        round,
         dt,
     } = *inputs;
     let p = &world.particles;
@@ -182,15 +184,13 @@ fn particle_contacts(
                 chunk.patches.add(key, f, g, merge);
             }
         }
-        let wm = &world.materials[wall.material];
-        let pm = &world.materials[t.material];
-        let e = pair_restitution(pm.restitution, wm.restitution);
-        let table = laws.damping_of(e);
-        let law = LawInputs {
-            stiffness: PairStiffness::particle_wall(pm, t.shape.equivalent_radius(), wm),
-            damping: &table,
-            friction: 0.5 * (pm.friction + wm.friction),
-            regularisation: (regularisation_length * t.shape.equivalent_radius()).powi(3),
+        let law = laws.wall(p.body_type[i], wall.material);
+        let damping = laws.damping(&law);
+        let inputs = LawInputs {
+            stiffness: law.stiffness,
+            damping,
+            friction: law.friction,
+            regularisation: law.regularisation,
             dt,
         };
         let spin = world.angular_velocity(i);
@@ -202,11 +202,31 @@ fn particle_contacts(
                 velocity: velocity_at(world, i, &spin, &g.point) - wall.velocity_at(&g.point),
                 spin: spin - wall.angular_velocity,
                 inverse_mass: inverse_mass_at(world, i, &g.point, &g.normal),
-                inertia: t.inertia.min(),
+                inertia: law.inertia,
             };
             let wall_key = (p.id[i], w as u32, key);
             let h = history.get(&wall_key).copied().unwrap_or_default();
-            let force = contact_force(g, &motion, &law, h, &p.position[i]);
+            let force = match (round, &t.shape) {
+                (RoundLaw::HertzMindlin { rolling }, Shape::Sphere(s)) => {
+                    let law = HertzInputs {
+                        materials: laws.materials(t.material, wall.material),
+                        rolling,
+                        radius: s.radius,
+                        rolling_inertia: rolling_inertia(t, s.radius),
+                        dt,
+                    };
+                    round_contact_force(
+                        g.depth,
+                        &g.normal,
+                        &g.point,
+                        &motion,
+                        &law,
+                        &h,
+                        &p.position[i],
+                    )
+                }
+                _ => contact_force(g, &motion, &inputs, h, &p.position[i]),
+            };
             let start = chunk.shares.len();
             chunk.shares.extend_from_slice(facet_shares);
             chunk.contacts.push(WallContact {

@@ -1,0 +1,150 @@
+//! Round contacts under the Hertz–Mindlin law: a sphere against a sphere, a
+//! polyhedron or a wall facet, when the scene chose that law (`[contact] law`).
+//!
+//! A sphere pair takes its own path, without the overlap volume and area the volume
+//! law needs: the depth, normal and contact point follow from the two centres, the
+//! effective mass is `m₁m₂/(m₁ + m₂)` (the contact point lies on the line of centres,
+//! so no rotation enters it), and the angular velocity of an isotropic body is its
+//! angular momentum over its moment of inertia.
+
+use nalgebra::{Point3, Vector3};
+
+use super::forces::{ContactForce, RelativeMotion};
+use crate::Real;
+use crate::contact::{
+    HertzContact, RollingContact, RollingModel, TangentialHistory, hertz_mindlin_force,
+    rolling_torque,
+};
+use crate::engine::laws::MaterialPair;
+use crate::geometry::Shape;
+use crate::world::{BodyType, World};
+
+/// What a round contact's law needs besides its geometry and motion.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct HertzInputs<'a> {
+    pub materials: &'a MaterialPair,
+    pub rolling: RollingModel,
+    /// Effective radius `R*`.
+    pub radius: Real,
+    /// Rolling inertia about the contact point (see [`crate::contact::rolling_torque`]).
+    pub rolling_inertia: Real,
+    pub dt: Real,
+}
+
+/// The rolling inertia `I + m r²` of body type `t` about a contact at distance `r`.
+#[inline]
+pub(super) fn rolling_inertia(t: &BodyType, r: Real) -> Real {
+    t.inertia.min() + t.mass * r * r
+}
+
+/// Effective radius of a pair of radii (infinite for a flat body).
+#[inline]
+pub(super) fn effective_radius(r1: Real, r2: Real) -> Real {
+    if r2.is_infinite() {
+        r1
+    } else if r1.is_infinite() {
+        r2
+    } else {
+        r1 * r2 / (r1 + r2)
+    }
+}
+
+/// The force and torque on body 2 (centroid `centre`) of a round contact of `depth`
+/// along `normal` at `point`.
+#[inline]
+pub(super) fn round_contact_force(
+    depth: Real,
+    normal: &Vector3<Real>,
+    point: &Point3<Real>,
+    motion: &RelativeMotion,
+    law: &HertzInputs,
+    history: &TangentialHistory,
+    centre: &Point3<Real>,
+) -> ContactForce {
+    let c = HertzContact {
+        depth,
+        normal: *normal,
+        relative_velocity: motion.velocity,
+        radius: law.radius,
+        mass: 1.0 / motion.inverse_mass,
+    };
+    let m = law.materials;
+    let f = hertz_mindlin_force(&c, &m.hertz, m.friction, history, law.dt);
+    let mut torque = (point - centre).cross(&f.force);
+    let mut history = f.history;
+    if law.rolling != RollingModel::None {
+        let contact = RollingContact {
+            normal: *normal,
+            relative_spin: motion.spin,
+            normal_force: f.normal,
+            normal_stiffness: f.stiffness,
+            radius: law.radius,
+            inertia: law.rolling_inertia,
+        };
+        let (rolling, spring) =
+            rolling_torque(law.rolling, &m.rolling, &contact, &history.rolling, law.dt);
+        torque += rolling;
+        history.rolling = spring;
+    }
+    ContactForce {
+        force: f.force,
+        torque,
+        history,
+        energy: f.energy,
+    }
+}
+
+/// The contact of spheres `i` and `j` (radii `ri`, `rj`), if they overlap: the sphere
+/// pair's own path (see the module docs).
+#[inline]
+pub(super) fn sphere_pair(
+    world: &World,
+    (i, ri): (usize, Real),
+    (j, rj): (usize, Real),
+    law: HertzInputs,
+    history: &TangentialHistory,
+) -> Option<ContactForce> {
+    let p = &world.particles;
+    let d = p.position[j] - p.position[i];
+    let distance_squared = d.norm_squared();
+    let reach = ri + rj;
+    if !(distance_squared < reach * reach) || distance_squared == 0.0 {
+        return None;
+    }
+    let distance = distance_squared.sqrt();
+    let normal = d / distance;
+    let depth = reach - distance;
+    let point = p.position[i] + normal * (ri - 0.5 * depth);
+    let (ti, tj) = (
+        &world.body_types[p.body_type[i] as usize],
+        &world.body_types[p.body_type[j] as usize],
+    );
+    let (wi, wj) = (
+        p.angular_momentum[i] / ti.inertia.x,
+        p.angular_momentum[j] / tj.inertia.x,
+    );
+    let motion = RelativeMotion {
+        velocity: p.velocity[j] + wj.cross(&(point - p.position[j]))
+            - p.velocity[i]
+            - wi.cross(&(point - p.position[i])),
+        spin: wj - wi,
+        inverse_mass: 1.0 / ti.mass + 1.0 / tj.mass,
+        inertia: 0.0,
+    };
+    Some(round_contact_force(
+        depth,
+        &normal,
+        &point,
+        &motion,
+        &law,
+        history,
+        &p.position[j],
+    ))
+}
+
+/// The radius a body of `shape` brings to a round contact: its own for a sphere,
+/// infinite (flat) for a polyhedron.
+#[inline]
+pub(super) fn round_radius(shape: &Shape) -> Real {
+    shape.as_sphere().map_or(Real::INFINITY, |s| s.radius)
+}
