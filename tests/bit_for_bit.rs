@@ -32,7 +32,7 @@ const CASES: [Case; 3] = [
             0x9e67ff0815da3557,
             0xd6fa5b7a1076ff8d,
             0x22fa1b300583c2c0,
-            0xd5a066b81d8ee57a,
+            0x1443e61d60723ec4,
         ],
     },
     Case {
@@ -43,7 +43,7 @@ const CASES: [Case; 3] = [
             0x17ed34423bde0539,
             0xb65e1ed59af58ef2,
             0xee638a32aac71c74,
-            0x6c78f59abd7df78f,
+            0x86bf92724c0358b3,
         ],
     },
     Case {

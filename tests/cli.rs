@@ -177,6 +177,25 @@ fn bench_runs_on_part_of_the_shipped_settled_bed() {
     assert!(stages.starts_with("integrate") && stages.contains("pair_contacts"));
     assert!((shares.iter().sum::<f64>() - 100.0).abs() < 0.5, "{stages}");
     // A scene that does not exist is named in the error.
-    let (ok, _, err) = talus(&["bench", "--scene", "d"]);
-    assert!(!ok && err.contains("--scene d"), "{err}");
+    let (ok, _, err) = talus(&["bench", "--scene", "e"]);
+    assert!(!ok && err.contains("--scene e"), "{err}");
+    // Scene (d): the three variants of the many-shapes lattice, and their ratios.
+    let (ok, out, err) = talus(&[
+        "bench",
+        "--scale",
+        "0.01",
+        "--steps",
+        "2",
+        "--scene",
+        "d",
+        "--threads",
+        "1",
+    ]);
+    assert!(ok, "{err}");
+    let rows = out
+        .lines()
+        .filter(|l| l.starts_with("(d) ") && !l.contains("setup") && !l.contains("thread(s)"));
+    assert_eq!(rows.count(), 3, "{out}");
+    assert_eq!(out.matches("s per thousand body types").count(), 3, "{out}");
+    assert!(out.contains("125 body types of 20 shapes step at"), "{out}");
 }

@@ -84,6 +84,9 @@ fn run_writes_the_series_and_the_summary() {
     assert_eq!(summary["steps"], 2500);
     assert_eq!(summary["particles"], 27);
     assert_eq!(summary["threads"], 2);
+    // The candidate pairs beside the contacts: at most every pair of the 27.
+    let candidates = summary["candidate_pairs"].as_u64().unwrap();
+    assert!(candidates <= 27 * 26 / 2, "{candidates}");
     // The time of each stage of the step, in step order; the shares add up to one.
     let stages = summary["stages"].as_array().unwrap();
     assert_eq!(stages.len(), 7);

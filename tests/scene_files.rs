@@ -83,6 +83,22 @@ fn errors_name_file_line_and_field() {
         "poisson = 0.7",
         &["materials.soft.poisson", "0.7"],
     );
+    // Rolling resistance belongs to Hertz–Mindlin, and its coefficient is checked.
+    assert_error(
+        "[contact]\nrolling = \"elastic_plastic\"\n",
+        "rolling =",
+        &["contact.rolling", "hertz_mindlin"],
+    );
+    assert_error(
+        "[contact]\nlaw = \"hertz_mindlin\"\n[materials.rough]\ndensity = 1000.0\nyoung = 1e6\npoisson = 0.3\nrestitution = 0.5\nrolling_friction = -0.1\n",
+        "rolling_friction",
+        &["materials.rough.rolling_friction", "-0.1"],
+    );
+    assert_error(
+        "[contact]\nlaw = \"hertz\"\n",
+        "law =",
+        &["hertz", "hertz_mindlin"],
+    );
     // A shape that cannot be built.
     assert_error(
         "[shapes.bad]\nkind = \"prism\"\nsides = 2\ndiameter = 0.01\nlength = 0.01\n",
@@ -197,6 +213,7 @@ count = 3
     assert!(plan.contains("sphere–sphere"), "{plan}");
     assert!(plan.contains("tangential history: kept"), "{plan}");
     assert!(plan.contains("wall kinematics: none"), "{plan}");
+    assert!(plan.contains("sphere contacts: volume law"), "{plan}");
 }
 
 #[test]

@@ -72,17 +72,20 @@ pub fn half_kick(state: &mut RotationState, torque: &Vector3<Real>, dt: Real) {
 
 /// Torque-free rotation over `dt` (see the module docs).
 pub fn free_rotation(state: &mut RotationState, inertia: &Vector3<Real>, dt: Real) {
+    if is_isotropic(inertia) {
+        // The midpoint rule's answer in closed form: L stays, and the body turns by
+        // the Cayley rotation of h ω / 2: q ⊗ (1, h ω_body / 2) normalised, written
+        // as q + (0, h ω / 2) ⊗ q with the world-frame ω = L / I (the same quaternion,
+        // without taking L into the body frame, and normalised once).
+        let w = state.angular_momentum * (0.5 * dt / inertia.x);
+        let q = state.orientation.into_inner();
+        let turned = q + Quaternion::from_imag(w) * q;
+        state.orientation = UnitQuaternion::new_unchecked(turned * (1.0 / turned.norm()));
+        return;
+    }
     let l0 = state
         .orientation
         .inverse_transform_vector(&state.angular_momentum);
-    if is_isotropic(inertia) {
-        // The midpoint rule's answer in closed form: L stays, and the body turns by
-        // the Cayley rotation of h ω / 2.
-        let w = l0 * (0.5 * dt / inertia.x);
-        let turn = UnitQuaternion::from_quaternion(Quaternion::new(1.0, w.x, w.y, w.z));
-        state.orientation = UnitQuaternion::new_normalize((state.orientation * turn).into_inner());
-        return;
-    }
     let inv_inertia = inertia.map(|i| 1.0 / i);
     let scale = l0.norm().max(Real::MIN_POSITIVE);
     let mut l1 = l0;

@@ -16,6 +16,7 @@
 use super::fast_hash::FastMap;
 use crate::Real;
 use crate::contact::{DampingTable, HertzMindlinPair, PairStiffness, RollingParameters};
+use crate::engine::RoundLaw;
 use crate::world::World;
 
 /// Restitution of a pair of materials: the mean of the two.
@@ -51,12 +52,27 @@ struct TypeRow {
     /// Volume-equivalent radius.
     radius: Real,
     material: usize,
+    /// What a sphere's own path reads, for a sphere type.
+    sphere: Option<SphereBody>,
+}
+
+/// A sphere body type as its own contact path reads it.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct SphereBody {
+    pub radius: Real,
+    pub inverse_mass: Real,
+    /// `1 / I` (isotropic).
+    pub inverse_inertia: Real,
+    /// `I + m r²`: the rolling inertia about a contact point.
+    pub rolling_inertia: Real,
+    pub material: usize,
 }
 
 /// One pair of materials' share of its contacts' parameters (walls included).
 #[derive(Clone, Copy, Debug)]
 pub(super) struct MaterialPair {
-    /// Index of the pair's damping table.
+    /// Index of the pair's damping table (`usize::MAX` where no contact follows the
+    /// volume law, see [`ContactLaws::prepare`]).
     table: usize,
     /// Coulomb friction coefficient (the mean of the materials').
     pub friction: Real,
@@ -89,14 +105,27 @@ impl ContactLaws {
     /// Prepares the rows for `world`'s materials and body types; `regularisation_length`
     /// is relative to the smaller equivalent radius of a pair (see
     /// [`crate::contact::normal_force`]).
-    pub(super) fn prepare(&mut self, world: &World, regularisation_length: Real) {
+    ///
+    /// The volume law's damping tables are calibrated only when a contact can follow
+    /// that law: not in a scene of spheres under Hertz–Mindlin (a calibration costs a
+    /// few tenths of a second).
+    pub(super) fn prepare(&mut self, world: &World, regularisation_length: Real, round: RoundLaw) {
         let materials = &world.materials;
+        let volume_law = round == RoundLaw::Volume
+            || world
+                .body_types
+                .iter()
+                .any(|t| t.shape.as_sphere().is_none());
         self.material_count = materials.len();
         self.materials.clear();
         for a in materials {
             for b in materials {
                 let e = pair_restitution(a.restitution, b.restitution);
-                let table = self.table_index(e);
+                let table = if volume_law {
+                    self.table_index(e)
+                } else {
+                    usize::MAX
+                };
                 let series = |x: Real, y: Real| x * y / (x + y);
                 self.materials.push(MaterialPair {
                     table,
@@ -124,6 +153,13 @@ impl ContactLaws {
                 inverse_inertia: 1.0 / t.inertia.min(),
                 radius,
                 material: t.material,
+                sphere: t.shape.as_sphere().map(|s| SphereBody {
+                    radius: s.radius,
+                    inverse_mass: 1.0 / t.mass,
+                    inverse_inertia: 1.0 / t.inertia.x,
+                    rolling_inertia: t.inertia.x + t.mass * s.radius * s.radius,
+                    material: t.material,
+                }),
             }
         }));
     }
@@ -139,6 +175,12 @@ impl ContactLaws {
     #[inline]
     pub(super) fn materials(&self, a: usize, b: usize) -> &MaterialPair {
         &self.materials[a * self.material_count + b]
+    }
+
+    /// Body type `t` as a sphere's own path reads it, if it is a sphere.
+    #[inline]
+    pub(super) fn sphere(&self, t: u32) -> Option<&SphereBody> {
+        self.types[t as usize].sphere.as_ref()
     }
 
     /// The law of a contact between body types `a` and `b`.
@@ -223,7 +265,7 @@ mod tests {
         }
         let mut laws = ContactLaws::default();
         let l = 0.05;
-        laws.prepare(&world, l);
+        laws.prepare(&world, l, RoundLaw::Volume);
         for (i, a) in world.body_types.iter().enumerate() {
             for (j, b) in world.body_types.iter().enumerate() {
                 let (ma, mb) = (&world.materials[a.material], &world.materials[b.material]);

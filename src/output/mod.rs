@@ -86,6 +86,9 @@ pub struct Summary {
     pub frozen: usize,
     /// Contacts at the end.
     pub contacts: usize,
+    /// Candidate pairs of the neighbour list at the end (pairs whose bounding spheres,
+    /// widened by the skin, overlap): what the narrow phase examined in the last step.
+    pub candidate_pairs: usize,
     /// Particle-steps per second of wall-clock time (particles integrated: frozen
     /// ones do not count).
     pub particle_steps_per_s: Real,

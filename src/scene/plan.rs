@@ -87,6 +87,20 @@ impl Plan {
                 "mixed kinds".into(),
             );
         }
+        if n_sphere > 0 {
+            let contact = &spec.contact;
+            let (law, why) = match contact.law {
+                super::spec::ContactLawSpec::Volume => (
+                    "volume law".to_string(),
+                    "[contact] law = \"volume\" (default)".to_string(),
+                ),
+                super::spec::ContactLawSpec::HertzMindlin => (
+                    format!("Hertz–Mindlin, rolling resistance: {:?}", contact.rolling),
+                    "[contact] law = \"hertz_mindlin\"; polyhedron pairs: volume law".to_string(),
+                ),
+            };
+            line(format!("sphere contacts: {law}"), why);
+        }
         let used: Vec<usize> = types
             .iter()
             .map(|t| t.material)

@@ -306,41 +306,19 @@ fn run_loop(
     }
     let drum = out.finish(sim.world())?;
     let elapsed = before.wall_clock_s + started.elapsed().as_secs_f64();
-    let report = sim.report();
-    let summary = Summary {
-        // Absolute, so that `talus analyze` finds it from anywhere.
-        scene: std::fs::canonicalize(&scene.file)
-            .unwrap_or_else(|_| scene.file.clone())
-            .display()
-            .to_string(),
-        ended_by: ended_by.into(),
-        time: report.time,
-        dt: scene.dt,
-        suggested_dt: scene.suggested.as_ref().map(|s| s.dt),
-        steps: sim.steps,
-        wall_clock_s: elapsed,
-        particles: report.particles,
-        frozen: sim.world().particles.frozen_count(),
-        contacts: report.contacts,
-        particle_steps_per_s: particle_steps as f64 / elapsed.max(1e-9),
-        contacts_per_s: contact_sum as f64 / elapsed.max(1e-9),
-        kinetic_energy: report.kinetic_energy,
-        max_speed: report.max_speed,
-        frames: out.frames(),
-        walls: sim
-            .world()
-            .walls
-            .iter()
-            .map(|w| WallSummary {
-                name: w.name.clone(),
-                force: w.force.into(),
-                torque: w.torque.into(),
-            })
-            .collect(),
-        threads: checkpoints.threads,
-        stages: StageSummary::of(sim.stage_times()),
+    let summary = summary(
+        scene,
+        &sim,
+        ended_by,
+        Totals {
+            elapsed,
+            particle_steps,
+            contact_sum,
+        },
+        out.frames(),
+        checkpoints.threads,
         drum,
-    };
+    );
     out.write_summary(&summary)?;
     if let Some(message) = blown_up {
         anyhow::bail!("{}: the run diverged: {message}", scene.file.display());
@@ -356,13 +334,69 @@ fn run_loop(
             "interrupted" => "interrupted",
             _ => "finished",
         },
-        report.time,
+        summary.time,
         sim.steps,
         elapsed,
         summary.particle_steps_per_s,
         summary.contacts_per_s,
-        report.particles,
+        summary.particles,
         dir.display()
     );
     Ok(())
+}
+
+/// What a run counted over all its stretches.
+struct Totals {
+    elapsed: f64,
+    particle_steps: u64,
+    contact_sum: u64,
+}
+
+/// The figures of `summary.json`.
+fn summary(
+    scene: &Scene,
+    sim: &Simulation,
+    ended_by: &str,
+    totals: Totals,
+    frames: usize,
+    threads: usize,
+    drum: Option<talus::analysis::DrumSummary>,
+) -> Summary {
+    let report = sim.report();
+    let elapsed = totals.elapsed.max(1e-9);
+    Summary {
+        // Absolute, so that `talus analyze` finds it from anywhere.
+        scene: std::fs::canonicalize(&scene.file)
+            .unwrap_or_else(|_| scene.file.clone())
+            .display()
+            .to_string(),
+        ended_by: ended_by.into(),
+        time: report.time,
+        dt: scene.dt,
+        suggested_dt: scene.suggested.as_ref().map(|s| s.dt),
+        steps: sim.steps,
+        wall_clock_s: totals.elapsed,
+        particles: report.particles,
+        frozen: sim.world().particles.frozen_count(),
+        contacts: report.contacts,
+        candidate_pairs: sim.stats().candidate_pairs,
+        particle_steps_per_s: totals.particle_steps as f64 / elapsed,
+        contacts_per_s: totals.contact_sum as f64 / elapsed,
+        kinetic_energy: report.kinetic_energy,
+        max_speed: report.max_speed,
+        frames,
+        walls: sim
+            .world()
+            .walls
+            .iter()
+            .map(|w| WallSummary {
+                name: w.name.clone(),
+                force: w.force.into(),
+                torque: w.torque.into(),
+            })
+            .collect(),
+        threads,
+        stages: StageSummary::of(sim.stage_times()),
+        drum,
+    }
 }

@@ -16,6 +16,7 @@ use crate::world::World;
 /// `pair_history[k]` and `overlap_plans[k]` belong to `list.pairs()[k]` of the list
 /// last built, unless `pending` holds a history set from outside, which is matched to
 /// the pairs (by particle ids) at the next build and until then is the history.
+/// `overlap_plans` is empty when the world had no polyhedra at that build.
 #[derive(Clone, Debug, Default)]
 pub(super) struct ContactState {
     /// Tangential history of each candidate pair.
@@ -69,8 +70,16 @@ impl ContactState {
         };
         list.build(world, radii);
         self.overlap_plans.clear();
-        self.overlap_plans
-            .resize(list.pairs().len(), OverlapCache::default());
+        // Only polyhedron pairs use a plan: a world of spheres keeps none (a plan is a
+        // few hundred bytes, written for every pair at every build).
+        if world
+            .body_types
+            .iter()
+            .any(|t| t.shape.as_polyhedron().is_some())
+        {
+            self.overlap_plans
+                .resize(list.pairs().len(), OverlapCache::default());
+        }
         self.pair_history.clear();
         self.pair_history.extend(list.pairs().iter().map(|&pair| {
             carried

@@ -33,6 +33,36 @@ impl ContactForce {
     }
 }
 
+/// What the gather reads of a pair's contact: the force and torque on body 2 and the
+/// elastic energy. The contact's history is written beside its pair instead, so that
+/// the results array the pair stage writes and the gather reads stays small.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct PairResult {
+    pub force: Vector3<Real>,
+    /// Torque on body 2 about its centroid.
+    pub torque: Vector3<Real>,
+    pub energy: Real,
+}
+
+impl PairResult {
+    /// Torque on body 1 about `x1`, given body 2's centroid `x2`.
+    #[inline]
+    pub(super) fn reaction_torque(&self, x1: &Point3<Real>, x2: &Point3<Real>) -> Vector3<Real> {
+        -(self.torque + (x2 - x1).cross(&self.force))
+    }
+}
+
+impl From<&ContactForce> for PairResult {
+    #[inline]
+    fn from(c: &ContactForce) -> Self {
+        PairResult {
+            force: c.force,
+            torque: c.torque,
+            energy: c.energy,
+        }
+    }
+}
+
 /// How body 2 moves relative to body 1 at a contact, and how hard it is to move.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct RelativeMotion {

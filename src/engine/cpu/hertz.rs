@@ -7,7 +7,7 @@
 //! so no rotation enters it), and the angular velocity of an isotropic body is its
 //! angular momentum over its moment of inertia.
 
-use nalgebra::{Point3, Vector3};
+use nalgebra::Vector3;
 
 use super::forces::{ContactForce, RelativeMotion};
 use crate::Real;
@@ -15,7 +15,7 @@ use crate::contact::{
     HertzContact, RollingContact, RollingModel, TangentialHistory, hertz_mindlin_force,
     rolling_torque,
 };
-use crate::engine::laws::MaterialPair;
+use crate::engine::laws::{MaterialPair, SphereBody};
 use crate::geometry::Shape;
 use crate::world::{BodyType, World};
 
@@ -49,17 +49,16 @@ pub(super) fn effective_radius(r1: Real, r2: Real) -> Real {
     }
 }
 
-/// The force and torque on body 2 (centroid `centre`) of a round contact of `depth`
-/// along `normal` at `point`.
+/// The force and torque on body 2 of a round contact of `depth` along `normal`, at
+/// `lever` from body 2's centroid.
 #[inline]
 pub(super) fn round_contact_force(
     depth: Real,
     normal: &Vector3<Real>,
-    point: &Point3<Real>,
+    lever: &Vector3<Real>,
     motion: &RelativeMotion,
     law: &HertzInputs,
     history: &TangentialHistory,
-    centre: &Point3<Real>,
 ) -> ContactForce {
     let c = HertzContact {
         depth,
@@ -70,7 +69,7 @@ pub(super) fn round_contact_force(
     };
     let m = law.materials;
     let f = hertz_mindlin_force(&c, &m.hertz, m.friction, history, law.dt);
-    let mut torque = (point - centre).cross(&f.force);
+    let mut torque = lever.cross(&f.force);
     let mut history = f.history;
     if law.rolling != RollingModel::None {
         let contact = RollingContact {
@@ -94,51 +93,43 @@ pub(super) fn round_contact_force(
     }
 }
 
-/// The contact of spheres `i` and `j` (radii `ri`, `rj`), if they overlap: the sphere
-/// pair's own path (see the module docs).
+/// The contact of spheres `i` and `j` (body types `a` and `b`), if they overlap:
+/// the sphere pair's own path (see the module docs).
 #[inline]
 pub(super) fn sphere_pair(
     world: &World,
-    (i, ri): (usize, Real),
-    (j, rj): (usize, Real),
+    (i, a): (usize, &SphereBody),
+    (j, b): (usize, &SphereBody),
     law: HertzInputs,
     history: &TangentialHistory,
 ) -> Option<ContactForce> {
     let p = &world.particles;
     let d = p.position[j] - p.position[i];
     let distance_squared = d.norm_squared();
-    let reach = ri + rj;
+    let reach = a.radius + b.radius;
     if !(distance_squared < reach * reach) || distance_squared == 0.0 {
         return None;
     }
     let distance = distance_squared.sqrt();
     let normal = d / distance;
     let depth = reach - distance;
-    let point = p.position[i] + normal * (ri - 0.5 * depth);
-    let (ti, tj) = (
-        &world.body_types[p.body_type[i] as usize],
-        &world.body_types[p.body_type[j] as usize],
+    // The contact point, and the levers from the centres to it.
+    let (ri, rj) = (
+        normal * (a.radius - 0.5 * depth),
+        normal * -(b.radius - 0.5 * depth),
     );
     let (wi, wj) = (
-        p.angular_momentum[i] / ti.inertia.x,
-        p.angular_momentum[j] / tj.inertia.x,
+        p.angular_momentum[i] * a.inverse_inertia,
+        p.angular_momentum[j] * b.inverse_inertia,
     );
     let motion = RelativeMotion {
-        velocity: p.velocity[j] + wj.cross(&(point - p.position[j]))
-            - p.velocity[i]
-            - wi.cross(&(point - p.position[i])),
+        velocity: p.velocity[j] + wj.cross(&rj) - p.velocity[i] - wi.cross(&ri),
         spin: wj - wi,
-        inverse_mass: 1.0 / ti.mass + 1.0 / tj.mass,
+        inverse_mass: a.inverse_mass + b.inverse_mass,
         inertia: 0.0,
     };
     Some(round_contact_force(
-        depth,
-        &normal,
-        &point,
-        &motion,
-        &law,
-        history,
-        &p.position[j],
+        depth, &normal, &rj, &motion, &law, history,
     ))
 }
 

@@ -25,7 +25,7 @@ mod walls;
 use std::ops::Range;
 
 use self::contact_state::ContactState;
-use self::forces::ContactForce;
+use self::forces::PairResult;
 use self::walls::{WallInputs, WallWork};
 use super::backend::{Backend, ContactHistory};
 use super::laws::ContactLaws;
@@ -42,7 +42,7 @@ struct Workspace {
     /// Bounding radius of every particle.
     radii: Vec<Real>,
     /// The pair results, aligned with the pair list.
-    results: Vec<Option<ContactForce>>,
+    results: Vec<Option<PairResult>>,
     /// Whether each particle touched another or a wall at the last force evaluation.
     touching: Vec<bool>,
     walls: WallWork,
@@ -86,7 +86,7 @@ impl CpuBackend {
             times,
         } = self;
         times.time(Stage::Laws, || {
-            laws.prepare(world, params.regularisation_length)
+            laws.prepare(world, params.regularisation_length, params.round_law)
         });
         times.time(Stage::NeighbourList, || {
             update_list(list, contacts, world, &mut work.radii)

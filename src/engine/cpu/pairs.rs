@@ -6,16 +6,17 @@ use rayon::prelude::*;
 
 use super::contact_state::ContactState;
 use super::dispatch::pair_geometry;
-use super::forces::{ContactForce, RelativeMotion, inverse_mass_at, pair_force, velocity_at};
+use super::forces::{
+    ContactForce, PairResult, RelativeMotion, inverse_mass_at, pair_force, velocity_at,
+};
 use super::hertz::{
     HertzInputs, effective_radius, rolling_inertia, round_contact_force, round_radius, sphere_pair,
 };
 use crate::Real;
-use crate::contact::TangentialHistory;
+use crate::contact::{RollingModel, TangentialHistory};
 use crate::engine::RoundLaw;
 use crate::engine::laws::ContactLaws;
 use crate::engine::neighbours::NeighbourList;
-use crate::geometry::Shape;
 use crate::geometry::overlap::OverlapCache;
 use crate::world::World;
 
@@ -42,33 +43,44 @@ fn pair_contact(
     history: &TangentialHistory,
     laws: &PairLaws,
 ) -> Option<ContactForce> {
-    let p = &world.particles;
-    let (ti, tj) = (
-        &world.body_types[p.body_type[i] as usize],
-        &world.body_types[p.body_type[j] as usize],
-    );
-    let RoundLaw::HertzMindlin { rolling } = laws.round else {
-        return pair_geometry(world, i, j, plan)
-            .map(|g| pair_force(world, i, j, &g, *history, laws.laws, laws.dt));
+    let volume = |plan: &mut OverlapCache| {
+        pair_geometry(world, i, j, plan)
+            .map(|g| pair_force(world, i, j, &g, *history, laws.laws, laws.dt))
     };
-    let inputs = |radius, rolling_inertia| HertzInputs {
-        materials: laws.laws.materials(ti.material, tj.material),
+    let RoundLaw::HertzMindlin { rolling } = laws.round else {
+        return volume(plan);
+    };
+    let p = &world.particles;
+    let (bi, bj) = (p.body_type[i], p.body_type[j]);
+    let inputs = |a: usize, b: usize, radius, rolling_inertia| HertzInputs {
+        materials: laws.laws.materials(a, b),
         rolling,
         radius,
         rolling_inertia,
         dt: laws.dt,
     };
-    match (&ti.shape, &tj.shape) {
-        (Shape::Polyhedron(_), Shape::Polyhedron(_)) => pair_geometry(world, i, j, plan)
-            .map(|g| pair_force(world, i, j, &g, *history, laws.laws, laws.dt)),
-        (Shape::Sphere(a), Shape::Sphere(b)) => {
-            let inertia =
-                1.0 / (1.0 / rolling_inertia(ti, a.radius) + 1.0 / rolling_inertia(tj, b.radius));
-            let law = inputs(effective_radius(a.radius, b.radius), inertia);
-            sphere_pair(world, (i, a.radius), (j, b.radius), law, history)
+    match (laws.laws.sphere(bi), laws.laws.sphere(bj)) {
+        (Some(a), Some(b)) => {
+            let inertia = if rolling == RollingModel::None {
+                0.0
+            } else {
+                1.0 / (1.0 / a.rolling_inertia + 1.0 / b.rolling_inertia)
+            };
+            let law = inputs(
+                a.material,
+                b.material,
+                effective_radius(a.radius, b.radius),
+                inertia,
+            );
+            sphere_pair(world, (i, a), (j, b), law, history)
         }
-        (si, sj) => {
+        (None, None) => volume(plan),
+        _ => {
             // A sphere and a polyhedron: the polyhedron is locally flat.
+            let (ti, tj) = (
+                &world.body_types[bi as usize],
+                &world.body_types[bj as usize],
+            );
             let g = pair_geometry(world, i, j, plan)?;
             let (wi, wj) = (world.angular_velocity(i), world.angular_velocity(j));
             let motion = RelativeMotion {
@@ -82,18 +94,15 @@ fn pair_contact(
             let lever = |k: usize| (g.point - p.position[k]).norm();
             let inertia =
                 1.0 / (1.0 / rolling_inertia(ti, lever(i)) + 1.0 / rolling_inertia(tj, lever(j)));
-            let law = inputs(
-                effective_radius(round_radius(si), round_radius(sj)),
-                inertia,
-            );
+            let radius = effective_radius(round_radius(&ti.shape), round_radius(&tj.shape));
+            let law = inputs(ti.material, tj.material, radius, inertia);
             Some(round_contact_force(
                 g.depth,
                 &g.normal,
-                &g.point,
+                &(g.point - p.position[j]),
                 &motion,
                 &law,
                 history,
-                &p.position[j],
             ))
         }
     }
@@ -109,30 +118,46 @@ pub(super) fn pair_contacts(
     state: &mut ContactState,
     radii: &[Real],
     laws: PairLaws,
-    results: &mut Vec<Option<ContactForce>>,
+    results: &mut Vec<Option<PairResult>>,
 ) {
     let p = &world.particles;
+    let evaluate = |[i, j]: [u32; 2], history: &mut TangentialHistory, plan: &mut OverlapCache| {
+        let (i, j) = (i as usize, j as usize);
+        let reach = radii[i] + radii[j];
+        let c = if !(p.is_passive(i) && p.is_passive(j))
+            && (p.position[j] - p.position[i]).norm_squared() < reach * reach
+        {
+            pair_contact(world, i, j, plan, history, &laws)
+        } else {
+            None
+        };
+        // A pair that stays apart keeps its empty history unwritten.
+        match &c {
+            Some(c) => *history = c.history,
+            None if !history.is_empty() => *history = TangentialHistory::default(),
+            None => {}
+        }
+        c.as_ref().map(PairResult::from)
+    };
     results.clear();
-    results.par_extend(
-        list.pairs()
-            .par_iter()
-            .zip(&mut state.pair_history)
-            .zip(&mut state.overlap_plans)
-            .with_min_len(PAIRS_PER_TASK)
-            .map(|((&[i, j], history), plan)| {
-                let (i, j) = (i as usize, j as usize);
-                let reach = radii[i] + radii[j];
-                let c = if !(p.is_passive(i) && p.is_passive(j))
-                    && (p.position[j] - p.position[i]).norm_squared() < reach * reach
-                {
-                    pair_contact(world, i, j, plan, history, &laws)
-                } else {
-                    None
-                };
-                *history = c.map(|c| c.history).unwrap_or_default();
-                c
-            }),
-    );
+    let pairs = list.pairs().par_iter().zip(&mut state.pair_history);
+    if state.overlap_plans.len() == list.pairs().len() {
+        results.par_extend(
+            pairs
+                .zip(&mut state.overlap_plans)
+                .with_min_len(PAIRS_PER_TASK)
+                .map(|((&pair, history), plan)| evaluate(pair, history, plan)),
+        );
+    } else {
+        // A world of spheres keeps no overlap plans (see `ContactState::rebuild`).
+        results.par_extend(
+            pairs
+                .with_min_len(PAIRS_PER_TASK)
+                .map_init(OverlapCache::default, |plan, (&pair, history)| {
+                    evaluate(pair, history, plan)
+                }),
+        );
+    }
 }
 
 /// Sets every owned particle's force to its weight plus its pairs' forces, gathered in
@@ -142,7 +167,7 @@ pub(super) fn pair_contacts(
 pub(super) fn gather(
     world: &mut World,
     list: &NeighbourList,
-    results: &[Option<ContactForce>],
+    results: &[Option<PairResult>],
     touching: &mut Vec<bool>,
 ) -> (usize, Real) {
     let p = &mut world.particles;

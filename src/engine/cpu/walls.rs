@@ -7,7 +7,7 @@
 
 use std::ops::Range;
 
-use nalgebra::Vector3;
+use nalgebra::{Isometry3, Point3, Vector3};
 use rayon::prelude::*;
 
 use super::dispatch::{facet_geometry, pose_of};
@@ -24,7 +24,7 @@ use crate::engine::fast_hash::FastMap;
 use crate::engine::laws::ContactLaws;
 use crate::engine::neighbours::NeighbourList;
 use crate::geometry::Shape;
-use crate::world::World;
+use crate::world::{Wall, World};
 
 /// Particles per chunk of the wall stage. The particles touching a wall are bunched
 /// (a bed sorted by height has its whole floor layer first), so chunks are small
@@ -61,10 +61,41 @@ pub(super) struct WallInputs<'a> {
     pub dt: Real,
 }
 
+/// One wall's facets in world coordinates with their unit normals, as of the pose
+/// they were placed at: a fixed wall's are placed once, a moving wall's once a step,
+/// instead of once for every particle near a facet.
+#[derive(Clone, Debug, Default)]
+struct PlacedFacets {
+    pose: Option<Isometry3<Real>>,
+    triangles: Vec<[Point3<Real>; 3]>,
+    normals: Vec<Vector3<Real>>,
+}
+
+impl PlacedFacets {
+    /// Places `wall`'s facets unless they are placed at its pose already.
+    fn update(&mut self, wall: &Wall) {
+        if self.pose == Some(wall.pose) && self.triangles.len() == wall.triangles.len() {
+            return;
+        }
+        self.pose = Some(wall.pose);
+        self.triangles.clear();
+        self.triangles
+            .extend((0..wall.triangles.len()).map(|f| wall.facet_world(f)));
+        self.normals.clear();
+        self.normals.extend(
+            self.triangles
+                .iter()
+                .map(|t| (t[1] - t[0]).cross(&(t[2] - t[0])).normalize()),
+        );
+    }
+}
+
 /// The stage's buffers.
 #[derive(Clone, Debug, Default)]
 pub(super) struct WallWork {
     chunks: Vec<WallChunk>,
+    /// Every wall's facets as placed in the world.
+    placed: Vec<PlacedFacets>,
     /// The patches' history being written this step (swapped with the kept one).
     next_history: FastMap<WallKey, TangentialHistory>,
 }
@@ -93,8 +124,14 @@ pub(super) fn wall_contacts(
     if work.chunks.len() < chunks {
         work.chunks.resize_with(chunks, WallChunk::default);
     }
+    work.placed
+        .resize_with(world.walls.len(), PlacedFacets::default);
+    for (placed, wall) in work.placed.iter_mut().zip(&world.walls) {
+        placed.update(wall);
+    }
     let w = &*world;
     let kept = &*history;
+    let placed = &work.placed;
     work.chunks[..chunks]
         .par_iter_mut()
         .enumerate()
@@ -104,7 +141,7 @@ pub(super) fn wall_contacts(
             let start = c * PARTICLES_PER_CHUNK;
             for i in start..(start + PARTICLES_PER_CHUNK).min(n) {
                 if !w.particles.is_passive(i) {
-                    particle_contacts(w, i, &inputs, kept, chunk);
+                    particle_contacts(w, i, &inputs, placed, kept, chunk);
                 }
             }
         });
@@ -146,6 +183,7 @@ fn particle_contacts(
     world: &World,
     i: usize,
     inputs: &WallInputs,
+    placed: &[PlacedFacets],
     history: &FastMap<WallKey, TangentialHistory>,
     chunk: &mut WallChunk,
 ) {
@@ -170,8 +208,10 @@ fn particle_contacts(
         }
         chunk.patches.clear();
         for &f in facets {
-            let tri = wall.facet_world(f as usize);
-            let n = (tri[1] - tri[0]).cross(&(tri[2] - tri[0])).normalize();
+            let (tri, n) = (
+                &placed[w].triangles[f as usize],
+                &placed[w].normals[f as usize],
+            );
             // Walls are one-sided: a particle whose centroid is behind a facet's plane
             // has passed it (or the mesh faces the wrong way) and is not pushed back
             // through from behind, where the half-infinite prism would meet it with
@@ -179,20 +219,12 @@ fn particle_contacts(
             if n.dot(&(p.position[i] - tri[0])) < 0.0 {
                 continue;
             }
-            let key = plane_key(&n, &tri[0], radius);
-            if let Some(g) = facet_geometry(&t.shape, &pose, &tri) {
+            let key = plane_key(n, &tri[0], radius);
+            if let Some(g) = facet_geometry(&t.shape, &pose, tri) {
                 chunk.patches.add(key, f, g, merge);
             }
         }
         let law = laws.wall(p.body_type[i], wall.material);
-        let damping = laws.damping(&law);
-        let inputs = LawInputs {
-            stiffness: law.stiffness,
-            damping,
-            friction: law.friction,
-            regularisation: law.regularisation,
-            dt,
-        };
         let spin = world.angular_velocity(i);
         for (key, g, facet_shares) in chunk.patches.iter() {
             if !(g.area > 0.0) || !g.normal.iter().all(|x| x.is_finite()) {
@@ -218,14 +250,22 @@ fn particle_contacts(
                     round_contact_force(
                         g.depth,
                         &g.normal,
-                        &g.point,
+                        &(g.point - p.position[i]),
                         &motion,
                         &law,
                         &h,
-                        &p.position[i],
                     )
                 }
-                _ => contact_force(g, &motion, &inputs, h, &p.position[i]),
+                _ => {
+                    let inputs = LawInputs {
+                        stiffness: law.stiffness,
+                        damping: laws.damping(&law),
+                        friction: law.friction,
+                        regularisation: law.regularisation,
+                        dt,
+                    };
+                    contact_force(g, &motion, &inputs, h, &p.position[i])
+                }
             };
             let start = chunk.shares.len();
             chunk.shares.extend_from_slice(facet_shares);
