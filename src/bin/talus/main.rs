@@ -114,15 +114,16 @@ enum Command {
         file: PathBuf,
     },
     /// Measure whole-step throughput (particle-steps/s, contacts/s) on a dense bed of
-    /// dodecahedra and on spheres in an STL box, on 1 and 2 threads.
+    /// dodecahedra, a pour of spheres into an STL box, a sphere bed and a lattice of
+    /// many distinct shapes, on 1 and 2 threads.
     Bench {
         /// Scale of the particle counts (1: 10 000 dodecahedra and 5000 spheres).
         #[arg(long, default_value_t = 1.0)]
         scale: f64,
-        /// Timed steps per run.
+        /// Timed steps per run (scene b is timed over its whole pour).
         #[arg(long, default_value_t = 200)]
         steps: usize,
-        /// Measure only these scenes (a, b, c; all by default).
+        /// Measure only these scenes (a, b, c, d; all by default).
         #[arg(long, value_delimiter = ',')]
         scene: Vec<char>,
         /// Measure on these thread counts.
