@@ -450,6 +450,23 @@ fn measure(scene: &Scene, threads: usize, warmup: usize, steps: usize) -> Result
     }))
 }
 
+/// One row of the table and the stage shares below it.
+fn print_row(name: &str, threads: usize, m: &Measured, dt: f64, error: &str) {
+    println!(
+        "{:<38} {:>7} {:>9} {:>10} {:>9.0} {:>8.1e} {:>16.3e} {:>14.3e} {:>10}",
+        name,
+        threads,
+        m.particles,
+        m.pairs,
+        m.contacts,
+        dt,
+        m.particle_steps,
+        m.contact_rate,
+        error
+    );
+    println!("{:<38} stages: {}", "", stage_line(&m.stages));
+}
+
 /// Stage shares as `name 12.3 %, ...`.
 fn stage_line(stages: &[(&str, f64)]) -> String {
     stages
@@ -488,19 +505,7 @@ fn many_shapes(dir: &Path, options: &BenchOptions) -> Result<()> {
         let mut rates = Vec::new();
         for (name, setup) in &setups {
             let m = measure(&setup.scene, threads, 20, options.steps)?;
-            println!(
-                "{:<38} {:>7} {:>9} {:>10} {:>9.0} {:>8.1e} {:>16.3e} {:>14.3e} {:>10}",
-                name,
-                threads,
-                m.particles,
-                m.pairs,
-                m.contacts,
-                setup.scene.dt,
-                m.particle_steps,
-                m.contact_rate,
-                "-"
-            );
-            println!("{:<38} stages: {}", "", stage_line(&m.stages));
+            print_row(name, threads, &m, setup.scene.dt, "-");
             rates.push((m.particle_steps, m.contact_rate));
         }
         println!(
@@ -596,19 +601,7 @@ pub fn bench(options: BenchOptions) -> Result<()> {
         };
         for &threads in &options.threads {
             let m = measure(&scene, threads, warmup, steps)?;
-            println!(
-                "{:<38} {:>7} {:>9} {:>10} {:>9.0} {:>8.1e} {:>16.3e} {:>14.3e} {:>10}",
-                name,
-                threads,
-                m.particles,
-                m.pairs,
-                m.contacts,
-                scene.dt,
-                m.particle_steps,
-                m.contact_rate,
-                error
-            );
-            println!("{:<38} stages: {}", "", stage_line(&m.stages));
+            print_row(name, threads, &m, scene.dt, &error);
         }
     }
     if wanted('d') {

@@ -9,7 +9,7 @@ use crate::contact::{
     DampingTable, NormalContact, PairStiffness, TangentialHistory, normal_force, rocking_damping,
     tangential_force, twisting_friction,
 };
-use crate::engine::laws::ContactLaws;
+use crate::engine::laws::{ContactLaws, PairLaw};
 use crate::world::World;
 
 /// The force and torque one contact puts on its second body; the first body gets the
@@ -85,6 +85,20 @@ pub(super) struct LawInputs<'a> {
     /// Regularisation volume `V₀` of the normal law.
     pub regularisation: Real,
     pub dt: Real,
+}
+
+impl<'a> LawInputs<'a> {
+    /// The inputs of a contact under `law`, one of `laws`'.
+    #[inline]
+    pub(super) fn new(laws: &'a ContactLaws, law: &PairLaw, dt: Real) -> Self {
+        LawInputs {
+            stiffness: law.stiffness,
+            damping: laws.damping(law),
+            friction: law.friction,
+            regularisation: law.regularisation,
+            dt,
+        }
+    }
 }
 
 /// Inverse of the effective mass of particle `i` at `point` along `n`: the lever
@@ -214,12 +228,11 @@ pub(super) fn pair_force(
             + inverse_mass_at(world, j, &g.point, &g.normal),
         inertia: law.inertia,
     };
-    let inputs = LawInputs {
-        stiffness: law.stiffness,
-        damping: laws.damping(&law),
-        friction: law.friction,
-        regularisation: law.regularisation,
-        dt,
-    };
-    contact_force(g, &motion, &inputs, history, &p.position[j])
+    contact_force(
+        g,
+        &motion,
+        &LawInputs::new(laws, &law, dt),
+        history,
+        &p.position[j],
+    )
 }

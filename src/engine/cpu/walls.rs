@@ -256,16 +256,13 @@ fn particle_contacts(
                         &h,
                     )
                 }
-                _ => {
-                    let inputs = LawInputs {
-                        stiffness: law.stiffness,
-                        damping: laws.damping(&law),
-                        friction: law.friction,
-                        regularisation: law.regularisation,
-                        dt,
-                    };
-                    contact_force(g, &motion, &inputs, h, &p.position[i])
-                }
+                _ => contact_force(
+                    g,
+                    &motion,
+                    &LawInputs::new(laws, &law, dt),
+                    h,
+                    &p.position[i],
+                ),
             };
             let start = chunk.shares.len();
             chunk.shares.extend_from_slice(facet_shares);
