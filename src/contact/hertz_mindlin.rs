@@ -50,6 +50,19 @@ impl HertzMindlinPair {
     }
 }
 
+/// The effective radius `R* = R₁R₂/(R₁ + R₂)` of two bodies' radii of curvature at a
+/// contact, an infinite radius standing for a flat body.
+#[inline]
+pub fn effective_radius(r1: Real, r2: Real) -> Real {
+    if r2.is_infinite() {
+        r1
+    } else if r1.is_infinite() {
+        r2
+    } else {
+        r1 * r2 / (r1 + r2)
+    }
+}
+
 /// One contact of two spheres, or of a sphere and a flat body.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct HertzContact {

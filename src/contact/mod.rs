@@ -66,7 +66,9 @@ mod tangential;
 
 pub use area::{rocking_damping, twisting_friction};
 pub use damping::DampingTable;
-pub use hertz_mindlin::{HertzContact, HertzMindlinForce, HertzMindlinPair, hertz_mindlin_force};
+pub use hertz_mindlin::{
+    HertzContact, HertzMindlinForce, HertzMindlinPair, effective_radius, hertz_mindlin_force,
+};
 pub use material::{Material, MaterialError, PairStiffness};
 pub use normal::{NormalContact, NormalForce, normal_force};
 pub use rolling::{RollingContact, RollingModel, RollingParameters, rolling_torque};

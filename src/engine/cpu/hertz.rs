@@ -37,18 +37,6 @@ pub(super) fn rolling_inertia(t: &BodyType, r: Real) -> Real {
     t.inertia.min() + t.mass * r * r
 }
 
-/// Effective radius of a pair of radii (infinite for a flat body).
-#[inline]
-pub(super) fn effective_radius(r1: Real, r2: Real) -> Real {
-    if r2.is_infinite() {
-        r1
-    } else if r1.is_infinite() {
-        r2
-    } else {
-        r1 * r2 / (r1 + r2)
-    }
-}
-
 /// The force and torque on body 2 of a round contact of `depth` along `normal`, at
 /// `lever` from body 2's centroid.
 #[inline]

@@ -9,11 +9,9 @@ use super::dispatch::pair_geometry;
 use super::forces::{
     ContactForce, PairResult, RelativeMotion, inverse_mass_at, pair_force, velocity_at,
 };
-use super::hertz::{
-    HertzInputs, effective_radius, rolling_inertia, round_contact_force, round_radius, sphere_pair,
-};
+use super::hertz::{HertzInputs, rolling_inertia, round_contact_force, round_radius, sphere_pair};
 use crate::Real;
-use crate::contact::{RollingModel, TangentialHistory};
+use crate::contact::{RollingModel, TangentialHistory, effective_radius};
 use crate::engine::RoundLaw;
 use crate::engine::laws::ContactLaws;
 use crate::engine::neighbours::NeighbourList;

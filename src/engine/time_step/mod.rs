@@ -35,7 +35,7 @@ mod search;
 
 use self::search::shortest_pair_period;
 use crate::Real;
-use crate::contact::{HertzMindlinPair, Material};
+use crate::contact::{HertzMindlinPair, Material, effective_radius};
 use crate::engine::RoundLaw;
 use crate::geometry::sphere::cap_volume;
 use crate::geometry::{ConvexPolyhedron, Shape};
@@ -213,14 +213,7 @@ fn period(k: Real, a: &Features, b: &Features) -> Option<Real> {
 /// Hertz–Mindlin's tangent stiffness `2 E* √(R* δ)` at `δ = SPHERE_REFERENCE_DEPTH · r`
 /// for bodies of sphere radii `ra`, `rb` (infinite: flat).
 fn hertz_stiffness(young: Real, ra: Real, rb: Real, r: Real) -> Real {
-    let effective = if ra.is_infinite() {
-        rb
-    } else if rb.is_infinite() {
-        ra
-    } else {
-        ra * rb / (ra + rb)
-    };
-    2.0 * young * (effective * SPHERE_REFERENCE_DEPTH * r).sqrt()
+    2.0 * young * (effective_radius(ra, rb) * SPHERE_REFERENCE_DEPTH * r).sqrt()
 }
 
 /// The stiffest wall contact of a body type of features `a` with walls of material
