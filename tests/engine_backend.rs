@@ -103,7 +103,7 @@ fn ghosts_give_the_owned_half_the_forces_of_the_whole_box() {
         b.neighbours()
             .incident(i)
             .iter()
-            .any(|&k| b.neighbours().pairs()[k as usize][1] as usize >= owned)
+            .any(|&e| b.neighbours().pairs()[e.pair()][1] as usize >= owned)
     });
     assert!(
         touching_ghost.count() >= 10,

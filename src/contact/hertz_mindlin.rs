@@ -34,6 +34,9 @@ pub struct HertzMindlinPair {
     pub shear: Real,
     /// `β = ln e / √(ln² e + π²)` ≤ 0 (0 for an elastic pair).
     pub beta: Real,
+    /// `√(4G*/E*)`, the ratio of the tangential to the normal damping coefficient
+    /// (`k_t / S_n = 4G*/E*`), kept so that a contact takes one square root for both.
+    pub damping_ratio: Real,
 }
 
 impl HertzMindlinPair {
@@ -42,10 +45,13 @@ impl HertzMindlinPair {
         let compliance = |m: &Material| (1.0 - m.poisson * m.poisson) / m.young;
         let shear_compliance = |m: &Material| 2.0 * (2.0 - m.poisson) * (1.0 + m.poisson) / m.young;
         let log = e.ln();
+        let young = 1.0 / (compliance(a) + compliance(b));
+        let shear = 1.0 / (shear_compliance(a) + shear_compliance(b));
         HertzMindlinPair {
-            young: 1.0 / (compliance(a) + compliance(b)),
-            shear: 1.0 / (shear_compliance(a) + shear_compliance(b)),
+            young,
+            shear,
             beta: log / (log * log + std::f64::consts::PI.powi(2)).sqrt(),
+            damping_ratio: (4.0 * shear / young).sqrt(),
         }
     }
 }
@@ -111,7 +117,7 @@ pub fn hertz_mindlin_force(
     let vn = c.relative_velocity.dot(&c.normal);
     let normal = (elastic - damping_n * vn).max(0.0);
     let kt = 8.0 * pair.shear * a;
-    let damping_t = -DAMPING_FACTOR * pair.beta * (kt * c.mass).sqrt();
+    let damping_t = damping_n * pair.damping_ratio;
     let t = tangential_force(
         history,
         &c.normal,

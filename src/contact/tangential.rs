@@ -66,22 +66,25 @@ pub fn tangential_force(
     damping: Real,
     limit: Real,
 ) -> TangentialForce {
+    // The spring turned into the current tangent plane keeps its length, unless the
+    // stiffness grew (then its force): one square root for both scalings.
     let previous = &history.spring;
-    let mut length = previous.norm();
-    // Stiffer: keep the force. Softer (or new): keep the displacement.
-    if history.stiffness > 0.0 && stiffness > history.stiffness {
-        length *= history.stiffness / stiffness;
-    }
     let mut spring = previous - normal * normal.dot(previous);
-    let projected = spring.norm();
+    let projected = spring.norm_squared();
     if projected > 0.0 {
-        spring *= length / projected;
+        let keep = if history.stiffness > 0.0 && stiffness > history.stiffness {
+            history.stiffness / stiffness
+        } else {
+            1.0
+        };
+        spring *= keep * (previous.norm_squared() / projected).sqrt();
     }
     let vt = relative_velocity - normal * normal.dot(relative_velocity);
     spring += vt * dt;
     let trial = -stiffness * spring - damping * vt;
-    let magnitude = trial.norm();
-    if magnitude <= limit || magnitude == 0.0 {
+    // A sticking contact (the common case of a bed) needs no square root.
+    let squared = trial.norm_squared();
+    if squared <= limit * limit || squared == 0.0 {
         return TangentialForce {
             force: trial,
             history: TangentialHistory {
@@ -92,6 +95,7 @@ pub fn tangential_force(
             sliding: false,
         };
     }
+    let magnitude = squared.sqrt();
     let force = trial * (limit / magnitude);
     // While sliding the spring is shortened, never lengthened, to what the cap allows:
     // resetting it to the length that alone gives the capped force would create spring

@@ -29,6 +29,35 @@ use super::broad_phase::BroadPhase;
 use crate::Real;
 use crate::world::World;
 
+/// One particle's share in a listed pair: the pair's index into
+/// [`NeighbourList::pairs`] and whether the particle is the pair's first (`i` of
+/// `[i, j]`), packed in 32 bits (the role in the top bit) so that the gather reads one
+/// word per pair and never the pair itself.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Incidence(u32);
+
+impl Incidence {
+    const FIRST: u32 = 1 << 31;
+
+    /// Pair `index` (below 2³¹) with the particle as its first (`first`) or second.
+    fn new(index: usize, first: bool) -> Self {
+        debug_assert!(index < Self::FIRST as usize);
+        Incidence(index as u32 | if first { Self::FIRST } else { 0 })
+    }
+
+    /// Index of the pair in [`NeighbourList::pairs`].
+    #[inline]
+    pub fn pair(self) -> usize {
+        (self.0 & !Self::FIRST) as usize
+    }
+
+    /// Whether the particle is the pair's first.
+    #[inline]
+    pub fn is_first(self) -> bool {
+        self.0 & Self::FIRST != 0
+    }
+}
+
 /// Skin as a fraction of the smallest bounding radius when none is set.
 pub const DEFAULT_SKIN: Real = 0.2;
 
@@ -43,7 +72,7 @@ pub struct NeighbourList {
     /// `incident[incident_starts[k]..incident_starts[k + 1]]`: the pairs holding
     /// particle `k`, ascending.
     incident_starts: Vec<u32>,
-    incident: Vec<u32>,
+    incident: Vec<Incidence>,
     /// `facets[facet_starts[k * walls + w]..facet_starts[k * walls + w + 1]]`: the
     /// facets of wall `w` near particle `k`, ascending.
     facet_starts: Vec<u32>,
@@ -71,8 +100,8 @@ impl NeighbourList {
         &self.pairs
     }
 
-    /// Indices into [`Self::pairs`] of the pairs holding particle `k`, ascending.
-    pub fn incident(&self, k: usize) -> &[u32] {
+    /// The pairs holding particle `k`, ascending.
+    pub fn incident(&self, k: usize) -> &[Incidence] {
         &self.incident[self.incident_starts[k] as usize..self.incident_starts[k + 1] as usize]
     }
 
@@ -172,6 +201,11 @@ impl NeighbourList {
 
     /// Fills the per-particle incidence lists of the (sorted) pairs.
     fn index_incident(&mut self, n: usize) {
+        assert!(
+            self.pairs.len() < Incidence::FIRST as usize,
+            "{} candidate pairs: at most 2³¹ fit the incidence lists",
+            self.pairs.len()
+        );
         self.incident_starts.clear();
         self.incident_starts.resize(n + 1, 0);
         for &[i, j] in &self.pairs {
@@ -182,11 +216,12 @@ impl NeighbourList {
             self.incident_starts[k + 1] += self.incident_starts[k];
         }
         self.incident.clear();
-        self.incident.resize(self.incident_starts[n] as usize, 0);
+        self.incident
+            .resize(self.incident_starts[n] as usize, Incidence(0));
         let mut fill = self.incident_starts.clone();
         for (index, &[i, j]) in self.pairs.iter().enumerate() {
-            for k in [i as usize, j as usize] {
-                self.incident[fill[k] as usize] = index as u32;
+            for (k, first) in [(i as usize, true), (j as usize, false)] {
+                self.incident[fill[k] as usize] = Incidence::new(index, first);
                 fill[k] += 1;
             }
         }

@@ -336,6 +336,9 @@ impl Simulation {
     /// stable one).
     pub fn first_non_finite(&self) -> Option<u64> {
         let p = &self.world.particles;
+        if p.all_finite() {
+            return None;
+        }
         (0..p.owned()).find(|&i| !p.is_finite(i)).map(|i| p.id[i])
     }
 

@@ -33,32 +33,35 @@ impl ContactForce {
     }
 }
 
-/// What the gather reads of a pair's contact: the force and torque on body 2 and the
-/// elastic energy. The contact's history is written beside its pair instead, so that
-/// the results array the pair stage writes and the gather reads stays small.
-#[derive(Clone, Copy, Debug)]
+/// What the gather reads of a pair: the force and the torque on each body and the
+/// elastic energy of its contact, all zero when the pair does not touch.
+///
+/// The contact's history is written beside its pair instead, so that the results
+/// array the pair stage writes and the gather reads stays small. The torque on body 1
+/// is taken here, where the pair's positions are at hand, and a pair apart adds
+/// zeros, so that the gather adds without a branch: its loads of scattered results
+/// then overlap instead of waiting on a mispredicted test each.
+#[derive(Clone, Copy, Debug, Default)]
 pub(super) struct PairResult {
+    /// Force on body 2; body 1 gets the opposite.
     pub force: Vector3<Real>,
-    /// Torque on body 2 about its centroid.
-    pub torque: Vector3<Real>,
+    /// Torque on body 1 ([`ContactForce::reaction_torque`]) and on body 2, each about
+    /// its centroid.
+    pub torques: [Vector3<Real>; 2],
     pub energy: Real,
+    /// Whether the bodies touch.
+    pub touching: bool,
 }
 
 impl PairResult {
-    /// Torque on body 1 about `x1`, given body 2's centroid `x2`.
+    /// The result of contact `c` between bodies at `x1` and `x2`.
     #[inline]
-    pub(super) fn reaction_torque(&self, x1: &Point3<Real>, x2: &Point3<Real>) -> Vector3<Real> {
-        -(self.torque + (x2 - x1).cross(&self.force))
-    }
-}
-
-impl From<&ContactForce> for PairResult {
-    #[inline]
-    fn from(c: &ContactForce) -> Self {
+    pub(super) fn new(c: &ContactForce, x1: &Point3<Real>, x2: &Point3<Real>) -> Self {
         PairResult {
             force: c.force,
-            torque: c.torque,
+            torques: [c.reaction_torque(x1, x2), c.torque],
             energy: c.energy,
+            touching: true,
         }
     }
 }

@@ -99,7 +99,7 @@ pub(super) fn sphere_pair(
         return None;
     }
     let distance = distance_squared.sqrt();
-    let normal = d / distance;
+    let normal = d * distance.recip();
     let depth = reach - distance;
     // The contact point, and the levers from the centres to it.
     let (ri, rj) = (

@@ -42,7 +42,7 @@ struct Workspace {
     /// Bounding radius of every particle.
     radii: Vec<Real>,
     /// The pair results, aligned with the pair list.
-    results: Vec<Option<PairResult>>,
+    results: Vec<PairResult>,
     /// Whether each particle touched another or a wall at the last force evaluation.
     touching: Vec<bool>,
     walls: WallWork,

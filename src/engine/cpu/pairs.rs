@@ -116,7 +116,7 @@ pub(super) fn pair_contacts(
     state: &mut ContactState,
     radii: &[Real],
     laws: PairLaws,
-    results: &mut Vec<Option<PairResult>>,
+    results: &mut Vec<PairResult>,
 ) {
     let p = &world.particles;
     let evaluate = |[i, j]: [u32; 2], history: &mut TangentialHistory, plan: &mut OverlapCache| {
@@ -135,7 +135,9 @@ pub(super) fn pair_contacts(
             None if !history.is_empty() => *history = TangentialHistory::default(),
             None => {}
         }
-        c.as_ref().map(PairResult::from)
+        c.as_ref().map_or_else(PairResult::default, |c| {
+            PairResult::new(c, &p.position[i], &p.position[j])
+        })
     };
     results.clear();
     let pairs = list.pairs().par_iter().zip(&mut state.pair_history);
@@ -165,12 +167,12 @@ pub(super) fn pair_contacts(
 pub(super) fn gather(
     world: &mut World,
     list: &NeighbourList,
-    results: &[Option<PairResult>],
+    results: &[PairResult],
     touching: &mut Vec<bool>,
 ) -> (usize, Real) {
     let p = &mut world.particles;
     let owned = p.owned();
-    let (types, gravity, position) = (&world.body_types, world.gravity, &p.position);
+    let (types, gravity) = (&world.body_types, world.gravity);
     touching.resize(p.len(), false);
     (&mut p.force, &mut p.torque, touching)
         .into_par_iter()
@@ -187,24 +189,20 @@ pub(super) fn gather(
             // A frozen particle is part of a bed, whether or not its contacts are
             // evaluated.
             *touching = p.frozen[k];
-            for &index in list.incident(k) {
-                let Some(c) = &results[index as usize] else {
-                    continue;
-                };
-                *touching = true;
-                let [i, j] = list.pairs()[index as usize].map(|x| x as usize);
-                if j == k {
-                    *force += c.force;
-                    *torque += c.torque;
-                } else {
-                    *force -= c.force;
-                    *torque += c.reaction_torque(&position[i], &position[j]);
-                }
+            // Adding a pair apart adds zeros: `x + 0.0` is `x`, and `x + (−1)·f` is
+            // `x − f`, so the sums are those of adding the touching pairs alone.
+            for &e in list.incident(k) {
+                let c = &results[e.pair()];
+                let role = usize::from(!e.is_first());
+                let sign = if e.is_first() { -1.0 } else { 1.0 };
+                *touching |= c.touching;
+                *force += c.force * sign;
+                *torque += c.torques[role];
             }
         });
     let (mut contacts, mut energy) = (0, 0.0);
-    for c in results.iter().flatten() {
-        contacts += 1;
+    for c in results {
+        contacts += usize::from(c.touching);
         energy += c.energy;
     }
     (contacts, energy)
