@@ -101,7 +101,7 @@ pub struct HertzMindlinForce {
 
 /// The Hertz–Mindlin force on body 2 of contact `c` (see the module docs), with
 /// friction coefficient `friction` and the contact's `history`.
-#[inline]
+#[inline(always)]
 pub fn hertz_mindlin_force(
     c: &HertzContact,
     pair: &HertzMindlinPair,

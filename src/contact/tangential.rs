@@ -57,6 +57,7 @@ pub struct TangentialForce {
 /// fluctuate. So a stiffer spring keeps its force (the displacement is scaled by
 /// `k_old / k_new`) and a softer one keeps its displacement: the stored energy never
 /// grows by a change of stiffness.
+#[inline(always)]
 pub fn tangential_force(
     history: &TangentialHistory,
     normal: &Vector3<Real>,

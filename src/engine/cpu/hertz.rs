@@ -39,7 +39,7 @@ pub(super) fn rolling_inertia(t: &BodyType, r: Real) -> Real {
 
 /// The force and torque on body 2 of a round contact of `depth` along `normal`, at
 /// `lever` from body 2's centroid.
-#[inline]
+#[inline(always)]
 pub(super) fn round_contact_force(
     depth: Real,
     normal: &Vector3<Real>,
