@@ -21,6 +21,7 @@ pub struct TangentialHistory {
 
 impl TangentialHistory {
     /// Whether there is nothing to keep.
+    #[inline]
     pub fn is_empty(&self) -> bool {
         self.spring == Vector3::zeros() && self.twist == 0.0 && self.rolling == Vector3::zeros()
     }

@@ -227,3 +227,71 @@ impl NeighbourList {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use nalgebra::UnitQuaternion;
+    use rand::{Rng, SeedableRng};
+
+    use super::*;
+    use crate::contact::Material;
+    use crate::geometry::{Shape, Sphere};
+    use crate::world::BodyType;
+
+    /// Every particle's incidence list names exactly the listed pairs that hold it,
+    /// ascending, each with the particle's role in it; and every pair within reach
+    /// plus skin is listed.
+    #[test]
+    fn incidence_lists_name_each_pair_of_a_particle_with_its_role() {
+        let material = Material {
+            name: "m".into(),
+            density: 1000.0,
+            young: 1e7,
+            poisson: 0.3,
+            restitution: 0.5,
+            friction: 0.5,
+            rolling_friction: 0.0,
+            rolling_damping: 0.0,
+        };
+        let mut world = World::default();
+        world.body_types.push(BodyType::new(
+            Shape::Sphere(Sphere::new(0.01).unwrap()),
+            &material,
+            0,
+        ));
+        world.materials.push(material);
+        let mut rng = rand_pcg::Pcg64::seed_from_u64(4);
+        for id in 0..300 {
+            let x = Point3::new(
+                rng.random_range(0.0..0.2),
+                rng.random_range(0.0..0.2),
+                rng.random_range(0.0..0.2),
+            );
+            world.particles.push(0, x, UnitQuaternion::identity(), id);
+        }
+        let radii = vec![0.01; 300];
+        let mut list = NeighbourList {
+            skin: Some(0.002),
+            ..Default::default()
+        };
+        list.build(&world, &radii);
+        let pairs = list.pairs();
+        let x = &world.particles.position;
+        let within = (0..300)
+            .flat_map(|i| (i + 1..300).map(move |j| (i, j)))
+            .filter(|&(i, j)| (x[i] - x[j]).norm() < 0.022)
+            .count();
+        assert!(within > 100, "{within} pairs within reach: a sparse test");
+        assert_eq!(pairs.len(), within);
+        for k in 0..300 {
+            let holding: Vec<usize> = (0..pairs.len())
+                .filter(|&p| pairs[p].contains(&(k as u32)))
+                .collect();
+            let listed: Vec<usize> = list.incident(k).iter().map(|e| e.pair()).collect();
+            assert_eq!(listed, holding, "particle {k}");
+            for e in list.incident(k) {
+                assert_eq!(e.is_first(), pairs[e.pair()][0] as usize == k);
+            }
+        }
+    }
+}

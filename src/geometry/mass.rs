@@ -63,6 +63,7 @@ impl MassProperties {
 /// Whether principal moments `inertia` are equal to round-off (a sphere, a cube, a
 /// Platonic solid): then the angular velocity is the angular momentum over any one of
 /// them, in every frame.
+#[inline]
 pub fn is_isotropic(inertia: &nalgebra::Vector3<crate::Real>) -> bool {
     inertia.max() - inertia.min() <= 1e-12 * inertia.max()
 }
