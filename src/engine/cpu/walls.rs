@@ -219,8 +219,10 @@ fn particle_contacts(
             // Walls are one-sided: a particle whose centroid is behind a facet's plane
             // has passed it (or the mesh faces the wrong way) and is not pushed back
             // through from behind, where the half-infinite prism would meet it with
-            // its whole volume at once.
-            if n.dot(&(p.position[i] - tri[0])) < 0.0 {
+            // its whole volume at once. A centroid farther from the plane than the
+            // bounding radius keeps the whole body off the facet.
+            let height = n.dot(&(p.position[i] - tri[0]));
+            if !(0.0..=radius).contains(&height) {
                 continue;
             }
             if let Some(g) = facet_geometry(&t.shape, &pose, tri) {
