@@ -77,19 +77,16 @@ impl Particles {
     /// sweep (`x · 0` is 0 for a finite `x` and NaN otherwise, and a sum holding a NaN
     /// is NaN), cheap enough for every step.
     pub fn all_finite(&self) -> bool {
+        // Each component times zero, so that large finite values cannot overflow.
+        fn zeros<'a>(v: impl Iterator<Item = &'a Vector3<Real>>) -> Real {
+            v.map(|x| x.x * 0.0 + x.y * 0.0 + x.z * 0.0).sum()
+        }
         let n = self.owned();
-        let zeros = |v: &[Vector3<Real>]| -> Real {
-            v.iter().map(|x| x.x * 0.0 + x.y * 0.0 + x.z * 0.0).sum()
-        };
-        let positions: Real = self.position[..n]
-            .iter()
-            .map(|x| x.coords.sum() * 0.0)
-            .sum();
-        (positions
-            + zeros(&self.velocity[..n])
-            + zeros(&self.angular_momentum[..n])
-            + zeros(&self.force[..n])
-            + zeros(&self.torque[..n]))
+        (zeros(self.position[..n].iter().map(|x| &x.coords))
+            + zeros(self.velocity[..n].iter())
+            + zeros(self.angular_momentum[..n].iter())
+            + zeros(self.force[..n].iter())
+            + zeros(self.torque[..n].iter()))
             == 0.0
     }
 
@@ -262,6 +259,7 @@ mod tests {
             );
         }
         p.velocity[1] = Vector3::new(1e308, 1e308, 1e308);
+        p.position[2] = Point3::new(1e308, 1e308, 1e308);
         assert!(p.all_finite());
         p.push_ghost(
             0,
