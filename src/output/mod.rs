@@ -88,6 +88,8 @@ pub struct Summary {
     pub contacts: usize,
     /// Candidate pairs of the neighbour list at the end (pairs whose bounding spheres,
     /// widened by the skin, overlap): what the narrow phase examined in the last step.
+    /// It depends on where the list was last built, so a resumed run, which builds
+    /// its list afresh, may count a few more or fewer than a run never stopped.
     pub candidate_pairs: usize,
     /// Particle-steps per second of wall-clock time (particles integrated: frozen
     /// ones do not count).
