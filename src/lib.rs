@@ -34,6 +34,7 @@ pub mod contact;
 pub mod cosim;
 pub mod engine;
 pub mod ffi;
+pub mod fluid;
 pub mod fmi;
 pub mod geometry;
 pub mod output;

@@ -317,6 +317,10 @@ impl Backend for Recording {
         self.log("walls".into());
         self.inner.walls_moved(world)
     }
+    fn fluid_changed(&mut self, world: &World) {
+        self.log("fluid".into());
+        self.inner.fluid_changed(world)
+    }
     fn world_changed(&mut self, world: &World) {
         self.ids.clone_from(&world.particles.id);
         self.log("world".into());

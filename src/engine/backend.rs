@@ -21,11 +21,13 @@
 //! | removed or reordered particles | [`Backend::particles_removed`] |
 //! | set particle velocities (a drag) | [`Backend::velocities_set`] |
 //! | set wall poses or velocities (drives, attached walls) | [`Backend::walls_moved`] |
+//! | set the fluid's cell inputs or updated its particle shares | [`Backend::fluid_changed`] |
 //! | restored a saved state | [`Backend::restore`] |
 //! | changed anything else in the world | [`Backend::world_changed`] |
 //!
 //! In the other direction: after [`Backend::step`] the walls' forces, torques and
-//! facet forces in the host world, and [`Backend::stats`], are those of the step; the
+//! facet forces in the host world, the fluid's exchange (each particle's drag, the
+//! impulse per cell), and [`Backend::stats`], are those of the step; the
 //! particle arrays are current after [`Backend::sync_to_host`] (the CPU backend works
 //! on the host world itself, so they always are). The host calls `sync_to_host`
 //! before it reads particles: at the end of a communication step, for an output row
@@ -105,6 +107,10 @@ pub trait Backend: Send + fmt::Debug {
 
     /// Wall poses or velocities were set in the host world.
     fn walls_moved(&mut self, world: &World);
+
+    /// The fluid's cell inputs (velocity, pressure gradient) or its particle shares
+    /// and solid fractions were set in the host world.
+    fn fluid_changed(&mut self, world: &World);
 
     /// Anything else in the host world changed: the backend takes the whole world
     /// again (its contact history kept).

@@ -40,11 +40,13 @@ pub enum Stage {
     Gather,
     /// Particle–wall contacts and their accumulation on walls and facets.
     WallContacts,
+    /// Drag and pressure-gradient forces of a coupled fluid, and their exchange.
+    Fluid,
 }
 
 impl Stage {
     /// Every stage, in step order.
-    pub const ALL: [Stage; 7] = [
+    pub const ALL: [Stage; 8] = [
         Stage::Integrate,
         Stage::WallMotion,
         Stage::Laws,
@@ -52,6 +54,7 @@ impl Stage {
         Stage::PairContacts,
         Stage::Gather,
         Stage::WallContacts,
+        Stage::Fluid,
     ];
 
     /// The stage's name in reports.
@@ -64,6 +67,7 @@ impl Stage {
             Stage::PairContacts => "pair_contacts",
             Stage::Gather => "gather",
             Stage::WallContacts => "wall_contacts",
+            Stage::Fluid => "fluid",
         }
     }
 }

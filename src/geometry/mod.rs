@@ -15,8 +15,11 @@
 //! - [`overlap`]: exact overlap volume, centroid and contact-area vector of two
 //!   convex polyhedra;
 //! - [`wall`]: polyhedron–triangle contact for wall meshes;
-//! - [`sphere`]: analytic sphere kernels.
+//! - [`sphere`]: analytic sphere kernels;
+//! - [`cell_volumes`]: a particle's volume split exactly among the cells of a grid;
+//! - [`quadrature`]: Gauss–Legendre rules.
 
+pub mod cell_volumes;
 mod error;
 pub mod generators;
 pub mod gjk;
@@ -27,6 +30,7 @@ pub mod overlap;
 mod plane;
 mod polygon;
 mod polyhedron;
+pub mod quadrature;
 mod rotation;
 mod shape;
 mod spec;

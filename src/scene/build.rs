@@ -146,6 +146,9 @@ impl<'a> Builder<'a> {
             let wall = self.wall(&path, w, cell)?;
             self.world.walls.push(wall);
         }
+        if let Some(fluid) = &self.spec.fluid {
+            self.world.fluid = Some(super::fluid::build_fluid(fluid, &self.world)?);
+        }
         let names: Vec<&String> = self.spec.shapes.keys().collect();
         let mut shape_names = vec![String::new(); self.world.body_types.len()];
         for (&(shape, _), &t) in &self.body_types {

@@ -11,6 +11,8 @@ mod analyses;
 mod build;
 pub mod energy_balance;
 mod error;
+mod fluid;
+mod fluid_coupling;
 mod locate;
 mod plan;
 pub mod poses;
@@ -23,6 +25,7 @@ use std::path::{Path, PathBuf};
 
 pub use build::MAX_THREADS;
 pub use error::{FieldError, FieldPath, FieldSegment, SceneError};
+pub use fluid_coupling::FluidError;
 pub use plan::Plan;
 pub use simulation::{Simulation, StepReport};
 pub use spec::SceneSpec;

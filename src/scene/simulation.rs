@@ -40,6 +40,8 @@ pub struct Simulation {
     freeze: Option<FreezeSpec>,
     /// The bed height last measured while feeding or freezing.
     pub(super) bed_height: Option<Real>,
+    /// Steps between updates of the fluid's particle shares (`[fluid]`).
+    fluid_interval: u64,
 }
 
 /// Simulated time between two measurements of the bed height (while inlets feed
@@ -84,9 +86,11 @@ impl Simulation {
             bed: scene.bed,
             freeze: scene.spec.bed.as_ref().and_then(|b| b.freeze.clone()),
             bed_height: None,
+            fluid_interval: scene.spec.fluid.as_ref().map_or(0, |f| f.update_interval),
         };
         sim.backend.world_changed(&sim.world);
         sim.insert();
+        sim.update_fluid();
         sim.initialise();
         sim
     }
@@ -238,6 +242,9 @@ impl Simulation {
         self.steps = self.steps.saturating_add(1);
         self.follow_bed(before);
         self.insert();
+        if self.fluid_interval > 0 && self.steps % self.fluid_interval == 0 {
+            self.update_fluid();
+        }
         self.update_settling();
     }
 

@@ -45,6 +45,46 @@ pub struct SceneSpec {
     pub drum: Option<DrumSpec>,
     /// Packed-bed analysis.
     pub bed: Option<BedSpec>,
+    /// A coupled fluid: its grid and drag.
+    pub fluid: Option<FluidSpec>,
+}
+
+/// `[fluid]`: the grid of a coupled CFD code, the fluid and its drag law (see
+/// [`crate::fluid`]). A coupled code sets each cell's velocity and pressure gradient
+/// and reads back the solid volume fraction, the mean particle velocity and the
+/// momentum source; without one the fluid stays as the scene gives it.
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct FluidSpec {
+    /// Corner of the grid (its lowest x, y, z).
+    pub origin: [Real; 3],
+    /// Cell edges along x, y, z, m.
+    pub cell: [Real; 3],
+    /// Cells along x, y, z.
+    pub cells: [usize; 3],
+    /// Fluid density, kg/m³.
+    pub density: Real,
+    /// Dynamic viscosity, Pa s.
+    pub viscosity: Real,
+    /// The drag law.
+    pub drag: crate::fluid::DragLaw,
+    /// Shape correction of the drag of non-spherical particles (default none).
+    #[serde(default)]
+    pub shape_correction: crate::fluid::ShapeCorrection,
+    /// The fluid's (interstitial) velocity in every cell at the start, m/s.
+    #[serde(default)]
+    pub velocity: [Real; 3],
+    /// The pressure gradient in every cell at the start, Pa/m (default: hydrostatic,
+    /// density × gravity).
+    pub pressure_gradient: Option<[Real; 3]>,
+    /// Steps between two updates of the particles' volume per cell (the solid
+    /// fraction and the weights of the exchange), default 10.
+    #[serde(default = "default_fluid_update")]
+    pub update_interval: u64,
+}
+
+fn default_fluid_update() -> u64 {
+    10
 }
 
 /// `[bed]`: the tube a bed is packed in, and how the packing is analysed (see

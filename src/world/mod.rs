@@ -1,6 +1,8 @@
 //! The state of a DEM world in flat arrays: particles (structure of arrays), body
 //! types (shape and material, stored once), materials, and triangulated walls.
 
+mod cell_shares;
+mod fluid;
 mod inlet;
 mod motion;
 mod particles;
@@ -8,6 +10,8 @@ mod walls;
 
 use nalgebra::Vector3;
 
+pub use cell_shares::CellShares;
+pub use fluid::{DragModel, FluidField, LocalFluid, MomentumExchange};
 pub use inlet::{Inlet, PLACEMENT_ATTEMPTS, is_free, random_orientation};
 pub use motion::{DriveInput, MotionKey, WallMotion, WallVelocity, advance_pose};
 pub use particles::Particles;
@@ -57,6 +61,8 @@ pub struct World {
     pub gravity: Vector3<Real>,
     /// Simulated time.
     pub time: Real,
+    /// The fluid of a CFD-coupled scene.
+    pub fluid: Option<FluidField>,
 }
 
 impl World {

@@ -6,6 +6,7 @@ use nalgebra::{Isometry3, Point3};
 use crate::Real;
 use crate::analysis::section::{convex_section, disc_disc_area, polygon_area, polygon_disc_area};
 use crate::geometry::Shape;
+use crate::geometry::quadrature::{GAUSS5_NODES, GAUSS5_WEIGHTS};
 use crate::world::World;
 
 /// A particle placed in the bed frame.
@@ -146,23 +147,9 @@ impl Body<'_> {
     }
 
     fn gauss(&self, lo: Real, hi: Real, radii: &[Real]) -> Vec<Real> {
-        const NODES: [Real; 5] = [
-            0.0,
-            -0.538_469_310_105_683_1,
-            0.538_469_310_105_683_1,
-            -0.906_179_845_938_664,
-            0.906_179_845_938_664,
-        ];
-        const WEIGHTS: [Real; 5] = [
-            0.568_888_888_888_888_9,
-            0.478_628_670_499_366_5,
-            0.478_628_670_499_366_5,
-            0.236_926_885_056_189_1,
-            0.236_926_885_056_189_1,
-        ];
         let (mid, half) = (0.5 * (lo + hi), 0.5 * (hi - lo));
         let mut out = vec![0.0; radii.len()];
-        for (x, w) in NODES.iter().zip(WEIGHTS) {
+        for (x, w) in GAUSS5_NODES.iter().zip(GAUSS5_WEIGHTS) {
             self.add_section_areas(mid + half * x, radii, w * half, &mut out);
         }
         out

@@ -15,6 +15,7 @@
 
 mod contact_state;
 mod dispatch;
+mod fluid;
 mod forces;
 mod hertz;
 mod motion;
@@ -75,7 +76,9 @@ impl CpuBackend {
     }
 
     /// Forces and torques of the current positions and velocities, stage by stage.
-    fn evaluate_forces(&mut self, world: &mut World, dt: Real) {
+    /// A step's evaluation (`stepped`) also counts the fluid's exchange over `dt`;
+    /// the one of `initialise` only sets the forces.
+    fn evaluate_forces(&mut self, world: &mut World, dt: Real, stepped: bool) {
         let Self {
             params,
             list,
@@ -125,6 +128,7 @@ impl CpuBackend {
                 totals,
             )
         });
+        times.time(Stage::Fluid, || fluid::fluid_forces(world, dt, stepped));
         stats.contacts = count;
         stats.pair_contacts = pair_contacts;
         stats.elastic_energy = energy;
@@ -174,7 +178,7 @@ impl Backend for CpuBackend {
     }
 
     fn initialise(&mut self, world: &mut World, dt: Real) {
-        self.evaluate_forces(world, dt);
+        self.evaluate_forces(world, dt, false);
     }
 
     /// One velocity-Verlet step: the stages in order.
@@ -184,7 +188,7 @@ impl Backend for CpuBackend {
             .time(Stage::Integrate, || motion::kick_drift(world, dt));
         self.times
             .time(Stage::WallMotion, || motion::advance_walls(world, dt));
-        self.evaluate_forces(world, dt);
+        self.evaluate_forces(world, dt, true);
         self.times
             .time(Stage::Integrate, || motion::closing_kick(world, dt));
         self.stats.integrated = integrated;
@@ -217,6 +221,9 @@ impl Backend for CpuBackend {
 
     /// The lists are checked against the walls' frames every step.
     fn walls_moved(&mut self, _world: &World) {}
+
+    /// The fluid stage reads the host world's field every step.
+    fn fluid_changed(&mut self, _world: &World) {}
 
     fn world_changed(&mut self, _world: &World) {
         self.list.invalidate();

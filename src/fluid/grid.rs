@@ -1,0 +1,114 @@
+//! The fluid's grid as talus sees it: axis-aligned cells of one size.
+
+use nalgebra::{Point3, Vector3};
+
+use crate::Real;
+use crate::geometry::cell_volumes::CellBounds;
+
+/// A structured grid of `counts` cells of size `cell` from `origin`.
+///
+/// # Invariant
+/// Cell sizes are positive and finite, counts at least 1; cell `[i, j, k]` has the
+/// flat index `i + nx (j + ny k)` (x fastest), the order of every per-cell array.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FluidGrid {
+    origin: Point3<Real>,
+    cell: Vector3<Real>,
+    counts: [usize; 3],
+    bounds: [Vec<Real>; 3],
+}
+
+impl FluidGrid {
+    /// A grid, or why the numbers make none.
+    pub fn new(
+        origin: Point3<Real>,
+        cell: Vector3<Real>,
+        counts: [usize; 3],
+    ) -> Result<Self, String> {
+        if !origin.coords.iter().all(|x| x.is_finite()) {
+            return Err("the origin must be finite".into());
+        }
+        if !cell.iter().all(|&h| h > 0.0 && h.is_finite()) {
+            return Err(format!(
+                "cell sizes must be positive, got {:?}",
+                cell.as_slice()
+            ));
+        }
+        if counts.contains(&0) || counts.iter().product::<usize>() > 50_000_000 {
+            return Err(format!(
+                "cell counts must be at least 1 and at most 5e7 in all, got {counts:?}"
+            ));
+        }
+        let bounds = std::array::from_fn(|a| {
+            (0..=counts[a])
+                .map(|k| origin[a] + cell[a] * k as Real)
+                .collect()
+        });
+        Ok(FluidGrid {
+            origin,
+            cell,
+            counts,
+            bounds,
+        })
+    }
+
+    /// Number of cells.
+    pub fn len(&self) -> usize {
+        self.counts.iter().product()
+    }
+
+    /// Whether the grid has no cells (never: see the invariant).
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Cells along each axis.
+    pub fn counts(&self) -> [usize; 3] {
+        self.counts
+    }
+
+    /// Volume of one cell.
+    pub fn cell_volume(&self) -> Real {
+        self.cell.product()
+    }
+
+    /// Size of a cell along each axis.
+    pub fn cell_size(&self) -> Vector3<Real> {
+        self.cell
+    }
+
+    /// The cell boundaries along each axis.
+    pub fn bounds(&self) -> CellBounds<'_> {
+        [&self.bounds[0], &self.bounds[1], &self.bounds[2]]
+    }
+
+    /// Flat index of cell `c`.
+    pub fn index(&self, c: [usize; 3]) -> usize {
+        c[0] + self.counts[0] * (c[1] + self.counts[1] * c[2])
+    }
+
+    /// Centre of the cell of flat index `n`.
+    pub fn centre(&self, n: usize) -> Point3<Real> {
+        let c = [
+            n % self.counts[0],
+            (n / self.counts[0]) % self.counts[1],
+            n / (self.counts[0] * self.counts[1]),
+        ];
+        Point3::from(Vector3::from_fn(|a, _| {
+            self.origin[a] + self.cell[a] * (c[a] as Real + 0.5)
+        }))
+    }
+
+    /// Flat index of the cell holding `p`, if any.
+    pub fn cell_of(&self, p: &Point3<Real>) -> Option<usize> {
+        let mut c = [0; 3];
+        for (a, c) in c.iter_mut().enumerate() {
+            let x = ((p[a] - self.origin[a]) / self.cell[a]).floor();
+            if !(x >= 0.0 && x < self.counts[a] as Real) {
+                return None;
+            }
+            *c = x as usize;
+        }
+        Some(self.index(c))
+    }
+}

@@ -1,0 +1,182 @@
+//! The fluid a coupled CFD code lays over the world: its grid, what it sets per cell
+//! (velocity, pressure gradient) and what it gets back (solid volume fraction, mean
+//! particle velocity, the momentum the particles took from it).
+
+use nalgebra::{Point3, Vector3};
+
+use super::{BodyType, CellShares, Particles};
+use crate::Real;
+use crate::fluid::{DragLaw, DragShape, FluidGrid, FluidProperties, ShapeCorrection};
+
+/// The drag model of a scene: fluid, law, shape correction and each body type's
+/// shape as the drag sees it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DragModel {
+    /// Density and viscosity.
+    pub properties: FluidProperties,
+    /// The drag law.
+    pub law: DragLaw,
+    /// The shape correction for non-spherical particles.
+    pub correction: ShapeCorrection,
+    /// Per body type.
+    pub shapes: Vec<DragShape>,
+}
+
+/// What the fluid exchanged with the particles since it was last read.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct MomentumExchange {
+    /// Per owned particle: the drag of the last force evaluation, N.
+    pub drag: Vec<Vector3<Real>>,
+    /// Per cell: the impulse of the drag the particles received, N s.
+    pub impulse: Vec<Vector3<Real>>,
+    /// Simulated time the impulses were summed over, s.
+    pub elapsed: Real,
+}
+
+/// The fluid field of a coupled scene.
+///
+/// # Invariant
+/// `velocity`, `pressure_gradient`, `solid_fraction`, `particle_velocity` and
+/// `exchange.impulse` have one entry per cell of `grid` (its flat order).
+#[derive(Clone, Debug, PartialEq)]
+pub struct FluidField {
+    /// The cells.
+    pub grid: FluidGrid,
+    /// How the fluid acts on particles.
+    pub model: DragModel,
+    /// Input per cell: the fluid's (interstitial) velocity, m/s.
+    pub velocity: Vec<Vector3<Real>>,
+    /// Input per cell: the pressure gradient, Pa/m (hydrostatic: density × gravity).
+    pub pressure_gradient: Vec<Vector3<Real>>,
+    /// Each particle's volume per cell, at the last update.
+    pub shares: CellShares,
+    /// Output per cell: solid volume fraction at the last update.
+    pub solid_fraction: Vec<Real>,
+    /// Output per cell: volume-weighted mean particle velocity at the last update.
+    pub particle_velocity: Vec<Vector3<Real>>,
+    /// The exchange since it was last read.
+    pub exchange: MomentumExchange,
+}
+
+/// What a particle reads of the fluid: its voidage, velocity and pressure gradient,
+/// averaged over the cells it lies in by its volume in each.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LocalFluid {
+    /// Fluid volume fraction.
+    pub voidage: Real,
+    /// Fluid velocity.
+    pub velocity: Vector3<Real>,
+    /// Pressure gradient.
+    pub pressure_gradient: Vector3<Real>,
+}
+
+impl FluidField {
+    /// A field on `grid` with uniform inputs and no particles yet.
+    pub fn new(
+        grid: FluidGrid,
+        model: DragModel,
+        velocity: Vector3<Real>,
+        pressure_gradient: Vector3<Real>,
+    ) -> Self {
+        let n = grid.len();
+        FluidField {
+            grid,
+            model,
+            velocity: vec![velocity; n],
+            pressure_gradient: vec![pressure_gradient; n],
+            shares: CellShares::default(),
+            solid_fraction: vec![0.0; n],
+            particle_velocity: vec![Vector3::zeros(); n],
+            exchange: MomentumExchange {
+                impulse: vec![Vector3::zeros(); n],
+                ..Default::default()
+            },
+        }
+    }
+
+    /// Splits every owned particle's volume among the cells again: the shares, the
+    /// solid fractions and the mean particle velocities (summed in particle order:
+    /// the same bits on any thread count).
+    pub fn update(&mut self, particles: &Particles, types: &[BodyType]) {
+        self.shares = CellShares::compute(&self.grid, particles, types);
+        let mut solid = vec![0.0; self.grid.len()];
+        let mut momentum = vec![Vector3::zeros(); self.grid.len()];
+        for i in 0..particles.owned() {
+            let (cells, volumes) = self.shares.of(i, particles.id[i]).expect("just computed");
+            for (&c, &v) in cells.iter().zip(volumes) {
+                solid[c as usize] += v;
+                momentum[c as usize] += particles.velocity[i] * v;
+            }
+        }
+        let cell = self.grid.cell_volume();
+        for ((phi, u), (s, m)) in self
+            .solid_fraction
+            .iter_mut()
+            .zip(&mut self.particle_velocity)
+            .zip(solid.iter().zip(&momentum))
+        {
+            *phi = s / cell;
+            *u = if *s > 0.0 { m / *s } else { Vector3::zeros() };
+        }
+    }
+
+    /// The fluid at particle `i` (of `id`, at `position`): through its shares when
+    /// they are up to date, else from the cell of its centroid; `None` outside the
+    /// grid. Visits each cell with the particle's weight in it through `cells`.
+    pub fn local(
+        &self,
+        i: usize,
+        id: u64,
+        position: &Point3<Real>,
+        mut cells: impl FnMut(usize, Real),
+    ) -> Option<LocalFluid> {
+        let one = |c: usize| LocalFluid {
+            voidage: (1.0 - self.solid_fraction[c]).max(0.0),
+            velocity: self.velocity[c],
+            pressure_gradient: self.pressure_gradient[c],
+        };
+        match self.shares.of(i, id) {
+            Some((cs, vs)) if !cs.is_empty() => {
+                let total: Real = vs.iter().sum();
+                let mut local = LocalFluid {
+                    voidage: 0.0,
+                    velocity: Vector3::zeros(),
+                    pressure_gradient: Vector3::zeros(),
+                };
+                for (&c, &v) in cs.iter().zip(vs) {
+                    let (w, f) = (v / total, one(c as usize));
+                    local.voidage += w * f.voidage;
+                    local.velocity += f.velocity * w;
+                    local.pressure_gradient += f.pressure_gradient * w;
+                    cells(c as usize, w);
+                }
+                Some(local)
+            }
+            Some(_) => None,
+            None => {
+                let c = self.grid.cell_of(position)?;
+                cells(c, 1.0);
+                Some(one(c))
+            }
+        }
+    }
+
+    /// The mean force the particles put on the fluid in each cell since the last
+    /// call (minus the drag they received, averaged over the time), which starts
+    /// the sums again. Zero when no time passed.
+    pub fn take_momentum_source(&mut self) -> Vec<Vector3<Real>> {
+        let t = self.exchange.elapsed;
+        let out = self
+            .exchange
+            .impulse
+            .iter_mut()
+            .map(|j| {
+                let f = if t > 0.0 { -*j / t } else { Vector3::zeros() };
+                *j = Vector3::zeros();
+                f
+            })
+            .collect();
+        self.exchange.elapsed = 0.0;
+        out
+    }
+}

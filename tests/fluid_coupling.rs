@@ -1,0 +1,359 @@
+//! CFD–DEM coupling against closed forms and published correlations: terminal
+//! settling velocities (Stokes, Schiller–Naumann; a cube and a dodecahedron with the
+//! Hölzer–Sommerfeld and Ganser correlations), the momentum given back to the fluid
+//! equal to what the particles received, and the fluid's inputs checked.
+
+use std::path::Path;
+
+use nalgebra::Vector3;
+use talus::Real;
+use talus::fluid::shape::{ganser_cd, holzer_sommerfeld_cd};
+use talus::fluid::{DragShape, ShapeCorrection};
+use talus::scene::{FluidError, Scene, Simulation};
+
+const G: Real = 9.81;
+
+/// One particle of `shape` (TOML), density 2500, at rest in a fluid at rest, falling
+/// for `end` seconds in steps of `dt` on a grid of 4 × 4 × 8 cells of 5 cm.
+fn falling(shape: &str, fluid: &str, end: Real, dt: Real) -> Simulation {
+    let text = format!(
+        r#"
+[simulation]
+dt = {dt}
+end_time = {end}
+gravity = [0.0, 0.0, -{G}]
+
+[materials.glass]
+density = 2500.0
+young = 1e7
+poisson = 0.3
+restitution = 0.5
+friction = 0.5
+
+[shapes.grain]
+{shape}
+
+[[particles]]
+kind = "list"
+shape = "grain"
+material = "glass"
+bodies = [{{ position = [0.1, 0.1, 0.3] }}]
+
+[fluid]
+origin = [0.0, 0.0, 0.0]
+cell = [0.05, 0.05, 0.05]
+cells = [4, 4, 8]
+{fluid}
+"#
+    );
+    let scene = Scene::parse(&text, Path::new("falling.toml")).unwrap();
+    let mut sim = Simulation::new(&scene);
+    while !sim.is_finished() {
+        sim.step();
+    }
+    sim
+}
+
+/// The speed at which `drag(v)` carries the buoyant weight `w`, by bisection.
+fn terminal(w: Real, drag: impl Fn(Real) -> Real) -> Real {
+    let (mut lo, mut hi) = (0.0, 100.0);
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if drag(mid) < w { lo = mid } else { hi = mid }
+    }
+    0.5 * (lo + hi)
+}
+
+fn settling_speed(sim: &Simulation) -> Real {
+    -sim.world().particles.velocity[0].z
+}
+
+#[test]
+fn a_sphere_in_creeping_flow_falls_at_stokes_velocity() {
+    // Glass in glycerol: Re ≈ 1e-3; relaxation time ρp d²/(18 μ) = 0.14 ms.
+    let (d, rho_f, mu) = (1e-3, 1260.0, 1.0);
+    let sim = falling(
+        "kind = \"sphere\"\nradius = 5e-4",
+        &format!("density = {rho_f}\nviscosity = {mu}\ndrag = \"stokes\""),
+        3e-3,
+        1.4e-6,
+    );
+    let stokes = (2500.0 - rho_f) * G * d * d / (18.0 * mu);
+    let v = settling_speed(&sim);
+    assert!((v / stokes - 1.0).abs() < 1e-3, "{v} against {stokes}");
+}
+
+#[test]
+fn a_sphere_at_moderate_reynolds_falls_at_the_schiller_naumann_velocity() {
+    // Glass (2 mm) in a viscous oil: Re ≈ 10; relaxation time about 10 ms.
+    let (d, rho_f, mu): (Real, Real, Real) = (2e-3, 1000.0, 0.02);
+    let sim = falling(
+        "kind = \"sphere\"\nradius = 1e-3",
+        &format!("density = {rho_f}\nviscosity = {mu}\ndrag = \"schiller_naumann\""),
+        0.25,
+        2e-4,
+    );
+    let volume = std::f64::consts::PI * d.powi(3) / 6.0;
+    let v_t = terminal((2500.0 - rho_f) * volume * G, |v| {
+        let re = rho_f * v * d / mu;
+        0.5 * rho_f * std::f64::consts::PI * d * d / 4.0 * v * v * 24.0 / re
+            * (1.0 + 0.15 * re.powf(0.687))
+    });
+    let re = rho_f * v_t * d / mu;
+    assert!(re > 5.0 && re < 30.0, "Re {re}");
+    let v = settling_speed(&sim);
+    assert!((v / v_t - 1.0).abs() < 1e-3, "{v} against {v_t} (Re {re})");
+}
+
+/// The terminal speed of `shape` under Schiller–Naumann with `correction`: the
+/// correlation's own drag coefficient of the shape at its pose (Hölzer–Sommerfeld:
+/// the crosswise sphericity from the area it shows the flow).
+fn shaped(shape: &str, correction: ShapeCorrection, name: &str) {
+    let (rho_f, mu): (Real, Real) = (1000.0, 0.02);
+    let sim = falling(
+        shape,
+        &format!(
+            "density = {rho_f}\nviscosity = {mu}\ndrag = \"schiller_naumann\"\nshape_correction = \"{name}\""
+        ),
+        0.25,
+        2e-4,
+    );
+    let w = sim.world();
+    let drag_shape = DragShape::of(&w.body_types[0].shape);
+    let (d, phi) = (drag_shape.diameter, drag_shape.sphericity);
+    // Straight down: the fluid puts no torque on a particle, so it keeps its pose.
+    let q = w.particles.orientation[0];
+    let shown = drag_shape.projected_area(&q, &Vector3::z());
+    let area = std::f64::consts::PI * d * d / 4.0;
+    let cd = |re: Real| match correction {
+        ShapeCorrection::HolzerSommerfeld => holzer_sommerfeld_cd(re, phi, area / shown),
+        _ => ganser_cd(re, phi),
+    };
+    let weight = (2500.0 - rho_f) * drag_shape.volume * G;
+    let v_t = terminal(weight, |v| {
+        0.5 * rho_f * area * v * v * cd(rho_f * v * d / mu)
+    });
+    let v = settling_speed(&sim);
+    assert!((v / v_t - 1.0).abs() < 1e-3, "{name}: {v} against {v_t}");
+    // A sphere of the same volume falls faster (by the same correlation).
+    let sphere_cd = |re: Real| match correction {
+        ShapeCorrection::HolzerSommerfeld => holzer_sommerfeld_cd(re, 1.0, 1.0),
+        _ => ganser_cd(re, 1.0),
+    };
+    let sphere = terminal(weight, |v| {
+        0.5 * rho_f * area * v * v * sphere_cd(rho_f * v * d / mu)
+    });
+    assert!(
+        v < 0.97 * sphere,
+        "{name}: {v} against the sphere's {sphere}"
+    );
+}
+
+#[test]
+fn a_cube_and_a_dodecahedron_fall_at_their_correlations_velocity() {
+    for (correction, name) in [
+        (ShapeCorrection::HolzerSommerfeld, "holzer_sommerfeld"),
+        (ShapeCorrection::Ganser, "ganser"),
+    ] {
+        shaped(
+            "kind = \"cuboid\"\nsize = [2e-3, 2e-3, 2e-3]",
+            correction,
+            name,
+        );
+        shaped(
+            "kind = \"platonic\"\nsolid = \"dodecahedron\"\ncircumradius = 1.2e-3",
+            correction,
+            name,
+        );
+    }
+}
+
+#[test]
+fn the_fluid_gets_back_exactly_the_drag_the_particles_received() {
+    let mut sim = falling(
+        "kind = \"platonic\"\nsolid = \"dodecahedron\"\ncircumradius = 0.02",
+        "density = 1.2\nviscosity = 1.8e-5\ndrag = \"di_felice\"\nvelocity = [0.3, -0.2, 2.0]\nupdate_interval = 3",
+        0.0,
+        1e-4,
+    );
+    // A particle straddling cells, in a fluid moving differently in each cell.
+    let cells = sim.fluid().unwrap().grid.len();
+    let velocity: Vec<_> = (0..cells)
+        .map(|c| Vector3::new(0.1 * (c % 5) as Real, 0.0, 1.0 + 0.01 * c as Real))
+        .collect();
+    sim.set_fluid_velocity(&velocity).unwrap();
+    sim.edit_world(|w| w.particles.position[0] = nalgebra::Point3::new(0.1, 0.1, 0.2));
+    sim.update_fluid();
+    sim.take_momentum_source().unwrap();
+    let mut received = Vector3::zeros();
+    let dt = sim.dt();
+    for _ in 0..40 {
+        sim.step();
+        received += sim.fluid().unwrap().exchange.drag[0] * dt;
+    }
+    let source = sim.take_momentum_source().unwrap();
+    let shares = source.iter().filter(|f| f.norm() > 0.0).count();
+    assert!(shares >= 4, "the particle straddles {shares} cells");
+    let given: Vector3<Real> = source.iter().sum::<Vector3<Real>>() * (40.0 * dt);
+    assert!(
+        (given + received).norm() <= 1e-12 * received.norm(),
+        "{given:?} against {received:?}"
+    );
+    // Read again: nothing new.
+    assert!(
+        sim.take_momentum_source()
+            .unwrap()
+            .iter()
+            .all(|f| f.norm() == 0.0)
+    );
+}
+
+#[test]
+fn fluid_inputs_of_the_wrong_size_or_not_finite_are_refused() {
+    let mut sim = falling(
+        "kind = \"sphere\"\nradius = 1e-3",
+        "density = 1000.0\nviscosity = 1e-3\ndrag = \"gidaspow\"",
+        0.0,
+        1e-4,
+    );
+    let cells = sim.fluid().unwrap().grid.len();
+    assert_eq!(cells, 128);
+    let before = sim.fluid().unwrap().velocity.clone();
+    assert_eq!(
+        sim.set_fluid_velocity(&vec![Vector3::zeros(); 5]),
+        Err(FluidError::Length {
+            what: "fluid velocity",
+            got: 5,
+            cells
+        })
+    );
+    let mut bad = vec![Vector3::zeros(); cells];
+    bad[17].y = Real::NAN;
+    assert_eq!(
+        sim.set_pressure_gradient(&bad),
+        Err(FluidError::NotFinite {
+            what: "pressure gradient",
+            cell: 17
+        })
+    );
+    assert_eq!(sim.fluid().unwrap().velocity, before);
+}
+
+/// The settled bed of 10 000 dodecahedra that `talus bench` ships (poured by
+/// talus, circumradius 5 mm, in a box 0.3155 m square), under a fluid of `grid`
+/// (the lines of `[fluid]` that place it) with the Gidaspow drag.
+fn poured_bed(grid: &str, rho: Real, mu: Real) -> Simulation {
+    let text = format!(
+        r#"
+[simulation]
+dt = 1e-6
+end_time = 1.0
+gravity = [0.0, 0.0, -9.81]
+
+[contact]
+regularisation = 0.2
+
+[materials.pla]
+density = 1500.0
+young = 1e6
+poisson = 0.1
+restitution = 0.5
+friction = 0.5
+
+[shapes.body]
+kind = "platonic"
+solid = "dodecahedron"
+circumradius = 0.005
+
+[[wall]]
+name = "box"
+material = "pla"
+geometry = {{ kind = "box", min = [0.0, 0.0, 0.0], max = [0.3155, 0.3155, 0.2], open_top = true }}
+
+[[particles]]
+kind = "file"
+shape = "body"
+material = "pla"
+file = "settled_dodecahedra.csv"
+
+[fluid]
+{grid}
+density = {rho}
+viscosity = {mu}
+drag = "gidaspow"
+"#
+    );
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("benches/data");
+    Simulation::new(&Scene::parse(&text, &dir.join("bed.toml")).unwrap())
+}
+
+#[test]
+fn the_solid_fractions_of_a_poured_bed_add_up_to_its_volume() {
+    // Cells of two particle diameters; the grid reaches a cell beyond the box, as
+    // some particles press into the walls.
+    let h = 0.3155 / 18.0;
+    let sim = poured_bed(
+        &format!("origin = [-{h}, -{h}, -{h}]\ncell = [{h}, {h}, {h}]\ncells = [20, 20, 7]"),
+        1000.0,
+        1e-3,
+    );
+    let fluid = sim.fluid().unwrap();
+    let total: Real = fluid.solid_fraction.iter().sum::<Real>() * fluid.grid.cell_volume();
+    let volume = sim.world().particles.len() as Real * sim.world().body_types[0].shape.volume();
+    assert!(
+        (total / volume - 1.0).abs() < 1e-12,
+        "{total} against {volume}"
+    );
+    // Cells of two diameters are far from uniform: the porosity of the inner cells
+    // ranges widely.
+    let inner: Vec<Real> = (0..fluid.grid.len())
+        .filter(|&c| fluid.grid.centre(c).z > 0.02 && fluid.grid.centre(c).z < 0.06)
+        .map(|c| fluid.solid_fraction[c])
+        .collect();
+    let (lo, hi) = inner.iter().fold((1.0, 0.0), |(lo, hi): (Real, Real), &s| {
+        (lo.min(s), hi.max(s))
+    });
+    assert!(lo < 0.45 && hi > 0.55, "solid fractions {lo}..{hi}");
+}
+
+/// The pressure drop a 1-D fluid model (the reactor and plug-flow models' grid:
+/// slabs across the whole box) takes from talus's momentum source across the
+/// poured bed, against Ergun's equation through the slabs' porosities with the
+/// volume-equivalent diameter.
+///
+/// The stand-in for the CFD code: a uniform superficial velocity `U` upward, the
+/// interstitial `U / ε` in each slab, and in steady flow the fluid's momentum
+/// balance of each slab (model A) `ε A ∆p = −S`, `S` the momentum source. The slabs
+/// compared lie inside the bed: above the first one at the floor, below the surface.
+#[test]
+fn the_pressure_drop_across_a_poured_bed_is_ergun() {
+    let (rho, mu, u) = (1000.0, 1e-3, 0.01);
+    let h = 0.3155 / 18.0;
+    let mut sim = poured_bed(
+        &format!("origin = [0.0, 0.0, 0.0]\ncell = [0.3155, 0.3155, {h}]\ncells = [1, 1, 6]"),
+        rho,
+        mu,
+    );
+    let fluid = sim.fluid().unwrap();
+    let eps: Vec<Real> = fluid.solid_fraction.iter().map(|s| 1.0 - s).collect();
+    let velocity: Vec<_> = eps.iter().map(|e| Vector3::new(0.0, 0.0, u / e)).collect();
+    sim.set_fluid_velocity(&velocity).unwrap();
+    sim.step();
+    let source = sim.take_momentum_source().unwrap();
+    let (area, slabs) = (0.3155 * 0.3155, 1..4);
+    let drop: Real = slabs.clone().map(|k| -source[k].z / (eps[k] * area)).sum();
+    // Ergun through the bed's porosity profile, slab by slab (the bed is graded:
+    // denser at the floor than under its surface).
+    let d = talus::fluid::DragShape::of(&sim.world().body_types[0].shape).diameter;
+    let ergun_gradient = |e: Real| {
+        150.0 * mu * (1.0 - e).powi(2) * u / (e.powi(3) * d * d)
+            + 1.75 * rho * (1.0 - e) * u * u / (e.powi(3) * d)
+    };
+    let ergun: Real = slabs.clone().map(|k| ergun_gradient(eps[k]) * h).sum();
+    println!(
+        "slab porosities {:.4} {:.4} {:.4}: ∆p {drop:.4} Pa, Ergun {ergun:.4} Pa",
+        eps[1], eps[2], eps[3]
+    );
+    assert!(eps[1] > 0.35 && eps[3] < 0.65, "{eps:?}");
+    assert!((drop / ergun - 1.0).abs() < 0.03, "{drop} against {ergun}");
+}
