@@ -12,8 +12,8 @@
 //! - A sphere's share of a cell is written through the volume `G(x, y, z)` of the
 //!   sphere below a corner (`X < x, Y < y, Z < z`) by inclusion–exclusion over the
 //!   cell's eight corners. `G` is a one-dimensional integral of the closed-form area of
-//!   a disc below a corner, taken by adaptive Gauss–Legendre quadrature between the
-//!   heights where that area has a kink. Neighbouring cells share their corners'
+//!   a disc below a corner, taken by tanh–sinh quadrature between the heights where
+//!   that area has a kink (square-root singularities at the ends of each piece). Neighbouring cells share their corners'
 //!   values, so the shares telescope: over cells that cover the sphere they add up to
 //!   `G` at the far corner, which is the sphere's exact volume, to round-off, whatever
 //!   the quadrature's own error (below 1e-12 of the sphere's volume per value).
@@ -22,7 +22,7 @@ use std::f64::consts::PI;
 
 use nalgebra::{Point3, Vector3};
 
-use super::quadrature::adaptive_gauss5;
+use super::quadrature::tanh_sinh;
 use super::{ConvexPolyhedron, Pose};
 use crate::Real;
 
@@ -253,10 +253,10 @@ pub fn volume_below_corner(radius: Real, x: Real, y: Real, z: Real) -> Real {
     }
     t.sort_by(Real::total_cmp);
     let area = |t: Real| disc_area_below_corner((r * r - t * t).max(0.0).sqrt(), x, y);
-    let tolerance = 1e-14 * r * r;
+    let tolerance = 1e-15 * r * r * r;
     t.windows(2)
         .filter(|w| w[1] > w[0])
-        .map(|w| adaptive_gauss5(&area, w[0], w[1], tolerance))
+        .map(|w| tanh_sinh(&area, w[0], w[1], tolerance))
         .sum()
 }
 

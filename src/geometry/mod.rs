@@ -17,7 +17,7 @@
 //! - [`wall`]: polyhedron–triangle contact for wall meshes;
 //! - [`sphere`]: analytic sphere kernels;
 //! - [`cell_volumes`]: a particle's volume split exactly among the cells of a grid;
-//! - [`quadrature`]: Gauss–Legendre rules.
+//! - [`quadrature`]: Gauss–Legendre and tanh–sinh rules.
 
 pub mod cell_volumes;
 mod error;

@@ -29,7 +29,7 @@ pub use fluid_coupling::FluidError;
 pub use plan::Plan;
 pub use simulation::{Simulation, StepReport};
 pub use spec::SceneSpec;
-pub use state::{InletState, SimState, WallState};
+pub use state::{FluidState, InletState, SimState, WallState};
 pub use state_bytes::{StateError, StateReader, StateWriter};
 
 use crate::Real;

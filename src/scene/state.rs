@@ -4,8 +4,8 @@
 //! What is kept is everything that evolves: the owned particles (with this step's
 //! forces, which the next half kick uses, and whether they are frozen), wall poses,
 //! velocities and forces, the tangential contact history, inlet counters, box offsets
-//! and random generators, time, step count, the settling clock and the bed height last
-//! measured. What a scene defines once (materials, shapes, wall meshes and their facet
+//! and random generators, time, step count, the settling clock, the bed height last
+//! measured, and a coupled fluid's inputs, particle shares and exchange. What a scene defines once (materials, shapes, wall meshes and their facet
 //! grids) is not: a state is restored into a simulation of the same scene. Restoring
 //! and stepping on gives the same bits as never having saved.
 
@@ -15,7 +15,7 @@ use super::Simulation;
 use super::state_bytes::{StateError, StateReader, StateWriter};
 use crate::Real;
 use crate::engine::{ContactHistory, StepStats};
-use crate::world::Particles;
+use crate::world::{CellShares, MomentumExchange, Particles};
 
 /// Everything of a [`Simulation`] that evolves.
 #[derive(Clone, Debug)]
@@ -42,6 +42,26 @@ pub struct SimState {
     pub inlets: Vec<InletState>,
     /// The tangential contact history.
     pub history: ContactHistory,
+    /// The fluid's inputs, shares and exchange, with a `[fluid]` section.
+    pub fluid: Option<FluidState>,
+}
+
+/// What evolves of a fluid field: what the coupled code set, the particles' shares
+/// of the cells at the last update and the exchange since it was last read.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FluidState {
+    /// Per cell: the fluid velocity.
+    pub velocity: Vec<Vector3<Real>>,
+    /// Per cell: the pressure gradient.
+    pub pressure_gradient: Vec<Vector3<Real>>,
+    /// Per cell: the solid fraction at the last update.
+    pub solid_fraction: Vec<Real>,
+    /// Per cell: the mean particle velocity at the last update.
+    pub particle_velocity: Vec<Vector3<Real>>,
+    /// The particles' shares of the cells.
+    pub shares: CellShares,
+    /// The exchange since it was last read.
+    pub exchange: MomentumExchange,
 }
 
 /// What evolves of a wall.
@@ -110,6 +130,14 @@ impl Simulation {
                 })
                 .collect(),
             history: self.backend.contact_history(),
+            fluid: world.fluid.as_ref().map(|f| FluidState {
+                velocity: f.velocity.clone(),
+                pressure_gradient: f.pressure_gradient.clone(),
+                solid_fraction: f.solid_fraction.clone(),
+                particle_velocity: f.particle_velocity.clone(),
+                shares: f.shares.clone(),
+                exchange: f.exchange.clone(),
+            }),
         }
     }
 
@@ -153,6 +181,14 @@ impl Simulation {
         self.next_id = state.next_id;
         self.quiet_since = state.quiet_since;
         self.bed_height = state.bed_height;
+        if let (Some(f), Some(s)) = (world.fluid.as_mut(), &state.fluid) {
+            f.velocity.clone_from(&s.velocity);
+            f.pressure_gradient.clone_from(&s.pressure_gradient);
+            f.solid_fraction.clone_from(&s.solid_fraction);
+            f.particle_velocity.clone_from(&s.particle_velocity);
+            f.shares = s.shares.clone();
+            f.exchange = s.exchange.clone();
+        }
         self.backend
             .restore(&self.world, state.history.clone(), state.stats);
         Ok(())
@@ -206,6 +242,7 @@ impl Simulation {
                 self.inlets.len()
             ));
         }
+        check_fluid(world.fluid.as_ref().map(|f| f.grid.len()), state)?;
         let mut inlets = self.inlets.clone();
         for (inlet, s) in inlets.iter_mut().zip(&state.inlets) {
             inlet.inserted = s.inserted;
@@ -216,5 +253,41 @@ impl Simulation {
                 .map_err(|e| StateError::Corrupt(format!("inlet generator: {e}")))?;
         }
         Ok(inlets)
+    }
+}
+
+/// Whether the state's fluid fits a scene whose grid has `cells` cells (`None`: no
+/// fluid).
+fn check_fluid(cells: Option<usize>, state: &SimState) -> Result<(), StateError> {
+    let corrupt = |m: String| Err(StateError::Corrupt(m));
+    match (cells, &state.fluid) {
+        (None, None) => Ok(()),
+        (Some(_), None) => corrupt("the scene has a fluid, the state none".into()),
+        (None, Some(_)) => corrupt("the state has a fluid, the scene none".into()),
+        (Some(n), Some(f)) => {
+            let lengths = [
+                f.velocity.len(),
+                f.pressure_gradient.len(),
+                f.solid_fraction.len(),
+                f.particle_velocity.len(),
+                f.exchange.impulse.len(),
+            ];
+            if lengths.iter().any(|&l| l != n) {
+                return corrupt(format!(
+                    "fluid arrays of {lengths:?} cells; the scene's grid has {n}"
+                ));
+            }
+            if f.shares.parts().1.iter().any(|&c| c as usize >= n) {
+                return corrupt(format!("fluid shares name cells beyond the grid's {n}"));
+            }
+            if f.exchange.drag.len() > state.particles.len()
+                || f.shares.len() > state.particles.len()
+            {
+                return corrupt(
+                    "fluid drag or shares for more particles than the state holds".into(),
+                );
+            }
+            Ok(())
+        }
     }
 }

@@ -3,7 +3,8 @@
 //! What is saved is everything that evolves: particles (with this step's forces, which
 //! the next half kick uses, and whether they are frozen), wall poses, velocities and
 //! forces, the tangential contact history, inlet counters, box offsets and random
-//! generators, time, step count, the settling clock and the bed height last measured.
+//! generators, time, step count, the settling clock, the bed height last measured, and
+//! a coupled fluid's inputs, particle shares and exchange.
 //! What a scene defines once (materials, shapes, wall meshes and their facet grids) is
 //! not saved: a state is restored into a simulation of the same scene, and a
 //! fingerprint of that scene in the header refuses any other. Restoring and stepping
@@ -19,16 +20,16 @@
 use nalgebra::{Isometry3, Point3, Quaternion, Translation3, UnitQuaternion, Vector3};
 use thiserror::Error;
 
-use super::state::{InletState, SimState, WallState};
+use super::state::{FluidState, InletState, SimState, WallState};
 use crate::Real;
 use crate::contact::TangentialHistory;
 use crate::engine::ContactHistory;
 use crate::engine::StepStats;
-use crate::world::Particles;
+use crate::world::{CellShares, MomentumExchange, Particles};
 
 /// The header of a state; the digit is the format's version (4: states in checked
-/// containers; 5: the rolling spring in the contact history).
-pub const STATE_MAGIC: &[u8; 8] = b"TALUSST5";
+/// containers; 5: the rolling spring in the contact history; 6: the fluid field).
+pub const STATE_MAGIC: &[u8; 8] = b"TALUSST6";
 
 /// Why bytes could not be restored as a state.
 #[derive(Debug, Error, PartialEq)]
@@ -299,6 +300,7 @@ impl SimState {
             plane.iter().for_each(|x| w.u64(*x as u64));
             write_history(w, h);
         }
+        write_fluid(w, self.fluid.as_ref());
     }
 
     /// Reads a state written by [`SimState::write`] for the scene with this
@@ -397,6 +399,7 @@ impl SimState {
             }
             history.walls.push(((id, wall, plane), read_history(r)?));
         }
+        let fluid = read_fluid(r)?;
         Ok(SimState {
             time,
             dt,
@@ -409,6 +412,80 @@ impl SimState {
             walls,
             inlets,
             history,
+            fluid,
         })
     }
+}
+
+fn write_vec3s(w: &mut StateWriter, v: &[Vector3<Real>]) {
+    w.u64(v.len() as u64);
+    v.iter().for_each(|x| w.vec3(x));
+}
+
+fn read_vec3s(r: &mut StateReader) -> Result<Vec<Vector3<Real>>, StateError> {
+    (0..r.count(24)?).map(|_| r.vec3()).collect()
+}
+
+fn write_fluid(w: &mut StateWriter, fluid: Option<&FluidState>) {
+    let Some(f) = fluid else {
+        w.u64(0);
+        return;
+    };
+    w.u64(1);
+    write_vec3s(w, &f.velocity);
+    write_vec3s(w, &f.pressure_gradient);
+    w.u64(f.solid_fraction.len() as u64);
+    f.solid_fraction.iter().for_each(|&x| w.f64(x));
+    write_vec3s(w, &f.particle_velocity);
+    let (starts, cells, volumes, ids) = f.shares.parts();
+    w.u64(ids.len() as u64);
+    ids.iter().for_each(|&x| w.u64(x));
+    starts.iter().for_each(|&x| w.u64(x as u64));
+    w.u64(cells.len() as u64);
+    for (&c, &v) in cells.iter().zip(volumes) {
+        w.u64(c as u64);
+        w.f64(v);
+    }
+    write_vec3s(w, &f.exchange.drag);
+    write_vec3s(w, &f.exchange.impulse);
+    w.f64(f.exchange.elapsed);
+}
+
+fn read_fluid(r: &mut StateReader) -> Result<Option<FluidState>, StateError> {
+    match r.u64()? {
+        0 => return Ok(None),
+        1 => {}
+        x => return Err(StateError::Corrupt(format!("fluid flag {x}, not 0 or 1"))),
+    }
+    let velocity = read_vec3s(r)?;
+    let pressure_gradient = read_vec3s(r)?;
+    let solid_fraction = (0..r.count(8)?)
+        .map(|_| r.f64())
+        .collect::<Result<_, _>>()?;
+    let particle_velocity = read_vec3s(r)?;
+    let ids: Vec<u64> = (0..r.count(16)?)
+        .map(|_| r.u64())
+        .collect::<Result<_, _>>()?;
+    let starts = (0..=ids.len())
+        .map(|_| r.u64().map(|x| x as u32))
+        .collect::<Result<_, _>>()?;
+    let (mut cells, mut volumes) = (Vec::new(), Vec::new());
+    for _ in 0..r.count(16)? {
+        cells.push(r.u64()? as u32);
+        volumes.push(r.f64()?);
+    }
+    let shares = CellShares::from_parts(starts, cells, volumes, ids, u32::MAX as usize)
+        .map_err(StateError::Corrupt)?;
+    Ok(Some(FluidState {
+        velocity,
+        pressure_gradient,
+        solid_fraction,
+        particle_velocity,
+        shares,
+        exchange: MomentumExchange {
+            drag: read_vec3s(r)?,
+            impulse: read_vec3s(r)?,
+            elapsed: r.f64()?,
+        },
+    }))
 }
