@@ -452,3 +452,156 @@ update_interval = 5
         restored.take_momentum_source()
     );
 }
+
+/// The scene of glass beads in a box under an upward water flow, with `fluid` as the
+/// `[fluid]` section's keys after the grid.
+fn beads_in_water(fluid: &str) -> String {
+    format!(
+        r#"
+[simulation]
+dt = 2e-6
+end_time = 0.002
+gravity = [0.0, 0.0, -9.81]
+
+[output]
+frame_interval = 0.001
+
+[materials.glass]
+density = 2500.0
+young = 1e7
+poisson = 0.3
+restitution = 0.5
+friction = 0.5
+
+[shapes.ball]
+kind = "sphere"
+radius = 0.002
+
+[[wall]]
+name = "box"
+material = "glass"
+geometry = {{ kind = "box", min = [0.0, 0.0, 0.0], max = [0.03, 0.03, 0.06], open_top = true }}
+
+[[particles]]
+kind = "lattice"
+shape = "ball"
+material = "glass"
+min = [0.0, 0.0, 0.0]
+max = [0.03, 0.03, 0.02]
+
+[fluid]
+origin = [0.0, 0.0, 0.0]
+cell = [0.01, 0.01, 0.01]
+{fluid}
+"#
+    )
+}
+
+/// The arrays of a `.vti` file written with raw appended data, by name.
+fn read_vti(path: &Path) -> Vec<(String, Vec<f32>)> {
+    let bytes = std::fs::read(path).unwrap();
+    let marker = b"<AppendedData encoding=\"raw\">\n   _";
+    let start = bytes
+        .windows(marker.len())
+        .position(|w| w == marker)
+        .unwrap()
+        + marker.len();
+    let text = String::from_utf8_lossy(&bytes[..start]).to_string();
+    let names: Vec<String> = text
+        .split("Name=\"")
+        .skip(1)
+        .map(|s| s[..s.find('"').unwrap()].to_string())
+        .collect();
+    let mut at = start;
+    names
+        .into_iter()
+        .map(|name| {
+            let len = u64::from_le_bytes(bytes[at..at + 8].try_into().unwrap()) as usize;
+            let data = bytes[at + 8..at + 8 + len]
+                .chunks(4)
+                .map(|c| f32::from_le_bytes(c.try_into().unwrap()))
+                .collect();
+            at += 8 + len;
+            (name, data)
+        })
+        .collect()
+}
+
+#[test]
+fn talus_run_writes_the_fluid_grid_for_paraview() {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("fluid_run");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let scene = dir.join("beads.toml");
+    std::fs::write(
+        &scene,
+        beads_in_water(
+            "cells = [3, 3, 6]\ndensity = 1000.0\nviscosity = 1e-3\ndrag = \"di_felice\"\nvelocity = [0.0, 0.0, 0.05]",
+        ),
+    )
+    .unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_talus"))
+        .args(["run", "--quiet", "--threads", "2", "--out"])
+        .arg(dir.join("out"))
+        .arg(&scene)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let pvd = std::fs::read_to_string(dir.join("out/fluid.pvd")).unwrap();
+    for t in ["0.000000000e0", "1.000000000e-3", "2.000000000e-3"] {
+        assert!(pvd.contains(&format!("timestep=\"{t}\"")), "{pvd}");
+    }
+    let arrays = read_vti(&dir.join("out/frames/fluid_000002.vti"));
+    let get = |n: &str| &arrays.iter().find(|a| a.0 == n).unwrap().1;
+    assert_eq!(get("solid_fraction").len(), 54);
+    assert_eq!(get("fluid_velocity").len(), 3 * 54);
+    // The beads' volume, in single precision; the flow drags them upward.
+    let solid: f64 = get("solid_fraction").iter().map(|&x| x as f64).sum::<f64>() * 1e-6;
+    let scene = Scene::load(&scene).unwrap();
+    let beads =
+        scene.world.particles.len() as f64 * 4.0 / 3.0 * std::f64::consts::PI * 0.002f64.powi(3);
+    assert!(
+        (solid / beads - 1.0).abs() < 1e-5,
+        "{solid} against {beads}"
+    );
+    let lift: f64 = get("particle_drag").chunks(3).map(|v| v[2] as f64).sum();
+    assert!(lift > 0.0, "{lift}");
+}
+
+#[test]
+fn a_bad_fluid_section_names_its_field() {
+    for (keys, field, what) in [
+        (
+            "cells = [3, 0, 6]\ndensity = 1000.0\nviscosity = 1e-3\ndrag = \"gidaspow\"",
+            "fluid.cells",
+            "at least 1",
+        ),
+        (
+            "cells = [3, 3, 6]\ndensity = 1000.0\nviscosity = -1e-3\ndrag = \"gidaspow\"",
+            "fluid.viscosity",
+            "positive",
+        ),
+        (
+            "cells = [3, 3, 6]\ndensity = 1000.0\nviscosity = 1e-3\ndrag = \"ergun\"",
+            "beads.toml:",
+            "unknown variant `ergun`",
+        ),
+        (
+            "cells = [3, 3, 6]\ndensity = 1000.0\nviscosity = 1e-3\ndrag = \"gidaspow\"\nupdate_interval = 0",
+            "fluid.update_interval",
+            "at least 1",
+        ),
+    ] {
+        let err = Scene::parse(&beads_in_water(keys), Path::new("beads.toml"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains(field) && err.contains(what) && err.contains("beads.toml"),
+            "{err}"
+        );
+    }
+}

@@ -11,6 +11,9 @@
 //! - `series.csv`: particles, contacts, kinetic energy and largest speed;
 //! - `summary.json`: the run's figures;
 //! - with a `[drum]` section, the drum's files (see [`drum`]);
+//! - with a `[fluid]` section, `fluid.pvd` and `frames/fluid_*.vti`: the fluid grid's
+//!   cells with the solid fraction, fluid and mean particle velocities, pressure
+//!   gradient and the drag the particles in each cell receive;
 //! - `checkpoint.talus` and `checkpoint.prev.talus` (when checkpoints are asked for or
 //!   the run is interrupted): the last two checkpoints, see [`crate::checkpoint`]; a
 //!   resumed run takes up the files above where a checkpoint left them
@@ -129,6 +132,8 @@ pub struct RunOutput {
     dir: PathBuf,
     particles: Collection,
     walls: Collection,
+    /// Frames of a coupled fluid's grid (none without one).
+    fluid: Collection,
     walls_csv: BufWriter<File>,
     series_csv: BufWriter<File>,
     frame_interval: Option<Real>,
@@ -174,6 +179,7 @@ impl RunOutput {
             dir: dir.to_path_buf(),
             particles: Collection::new(dir.join("particles.pvd")),
             walls: Collection::new(dir.join("walls.pvd")),
+            fluid: Collection::new(dir.join("fluid.pvd")),
             walls_csv,
             series_csv,
             frame_interval,
@@ -298,6 +304,11 @@ impl RunOutput {
         if !world.walls.is_empty() {
             vtk::write_walls(world, &self.dir.join(&w))?;
             self.walls.add(world.time, w)?;
+        }
+        if world.fluid.is_some() {
+            let f = format!("frames/fluid_{k:06}.vti");
+            vtk::write_fluid(world, &self.dir.join(&f))?;
+            self.fluid.add(world.time, f)?;
         }
         Ok(())
     }

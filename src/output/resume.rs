@@ -30,6 +30,9 @@ pub struct OutputCursor {
     last_frame: Option<Real>,
     particle_frames: Vec<(Real, String)>,
     wall_frames: Vec<(Real, String)>,
+    /// Frames of a coupled fluid's grid.
+    #[serde(default)]
+    fluid_frames: Vec<(Real, String)>,
     /// Bytes of `walls.csv` and `series.csv` written.
     walls_csv: u64,
     series_csv: u64,
@@ -85,6 +88,7 @@ impl RunOutput {
             last_frame: self.last_frame,
             particle_frames: self.particles.frames().to_vec(),
             wall_frames: self.walls.frames().to_vec(),
+            fluid_frames: self.fluid.frames().to_vec(),
             walls_csv,
             series_csv,
             drum,
@@ -110,6 +114,7 @@ impl RunOutput {
             dir: dir.to_path_buf(),
             particles: Collection::restore(dir.join("particles.pvd"), c.particle_frames)?,
             walls: Collection::restore(dir.join("walls.pvd"), c.wall_frames)?,
+            fluid: Collection::restore(dir.join("fluid.pvd"), c.fluid_frames)?,
             walls_csv: BufWriter::new(open_at(&dir.join("walls.csv"), c.walls_csv)?),
             series_csv: BufWriter::new(open_at(&dir.join("series.csv"), c.series_csv)?),
             frame_interval,

@@ -5,7 +5,7 @@
 //! is one polygon cell in its current pose (spheres as 80-facet icospheres), with the
 //! particle's id, kind, velocity, speed and angular velocity on each of its cells.
 //! Walls are their facets in the current pose, with the wall index and the force on
-//! each facet.
+//! each facet. A coupled fluid's grid is ImageData (`.vti`) with its cell fields.
 
 use std::fmt::Write as _;
 use std::fs::File;
@@ -115,18 +115,76 @@ impl PolyData {
         xml.push_str("      </Points>\n      <Polys>\n");
         header(&conn, &mut xml, &mut blocks);
         header(&offs, &mut xml, &mut blocks);
-        xml.push_str(
-            "      </Polys>\n    </Piece>\n  </PolyData>\n  <AppendedData encoding=\"raw\">\n   _",
-        );
-        let mut out = BufWriter::new(File::create(path)?);
-        out.write_all(xml.as_bytes())?;
-        for b in blocks {
-            out.write_all(&(b.len() as u64).to_le_bytes())?;
-            out.write_all(&b)?;
-        }
-        out.write_all(b"\n  </AppendedData>\n</VTKFile>\n")?;
-        out.flush()
+        xml.push_str("      </Polys>\n    </Piece>\n  </PolyData>\n");
+        write_appended(path, &xml, blocks)
     }
+}
+
+/// Writes the XML head `xml` and then `blocks` as the raw appended data (each headed
+/// by its length).
+fn write_appended(path: &Path, xml: &str, blocks: Vec<Vec<u8>>) -> io::Result<()> {
+    let mut out = BufWriter::new(File::create(path)?);
+    out.write_all(xml.as_bytes())?;
+    out.write_all(b"  <AppendedData encoding=\"raw\">\n   _")?;
+    for b in blocks {
+        out.write_all(&(b.len() as u64).to_le_bytes())?;
+        out.write_all(&b)?;
+    }
+    out.write_all(b"\n  </AppendedData>\n</VTKFile>\n")?;
+    out.flush()
+}
+
+/// Writes the fluid grid of `world` as VTK ImageData (`.vti`) to `path`, with per
+/// cell: the solid fraction and the mean particle velocity of the last update, the
+/// fluid velocity and pressure gradient set, and the drag the particles in it
+/// receive at this step (N; the momentum source is its opposite).
+pub fn write_fluid(world: &World, path: &Path) -> io::Result<()> {
+    let Some(fluid) = &world.fluid else {
+        return Ok(());
+    };
+    let grid = &fluid.grid;
+    let p = &world.particles;
+    let mut drag = vec![nalgebra::Vector3::zeros(); grid.len()];
+    for (i, f) in fluid.exchange.drag.iter().enumerate().take(p.owned()) {
+        fluid.local(i, p.id[i], &p.position[i], |c, w| drag[c] += f * w);
+    }
+    let vectors = |name: &str, v: &[nalgebra::Vector3<Real>]| Array::F32 {
+        name: name.into(),
+        components: 3,
+        data: v.iter().flat_map(|x| x.iter().map(|&y| y as f32)).collect(),
+    };
+    let arrays = [
+        Array::F32 {
+            name: "solid_fraction".into(),
+            components: 1,
+            data: fluid.solid_fraction.iter().map(|&x| x as f32).collect(),
+        },
+        vectors("fluid_velocity", &fluid.velocity),
+        vectors("pressure_gradient", &fluid.pressure_gradient),
+        vectors("particle_velocity", &fluid.particle_velocity),
+        vectors("particle_drag", &drag),
+    ];
+    let [nx, ny, nz] = grid.counts();
+    let o = grid.centre(0) - grid.cell_size() * 0.5;
+    let h = grid.cell_size();
+    let mut xml = format!(
+        r#"<?xml version="1.0"?>
+<VTKFile type="ImageData" version="1.0" byte_order="LittleEndian" header_type="UInt64">
+  <ImageData WholeExtent="0 {nx} 0 {ny} 0 {nz}" Origin="{} {} {}" Spacing="{} {} {}">
+    <Piece Extent="0 {nx} 0 {ny} 0 {nz}">
+      <CellData>
+"#,
+        o.x, o.y, o.z, h.x, h.y, h.z
+    );
+    let (mut offset, mut blocks) = (0, Vec::new());
+    for a in &arrays {
+        let b = a.bytes();
+        let _ = writeln!(xml, "        {}", a.header(offset));
+        offset += 8 + b.len();
+        blocks.push(b);
+    }
+    xml.push_str("      </CellData>\n    </Piece>\n  </ImageData>\n");
+    write_appended(path, &xml, blocks)
 }
 
 /// Writes the particles of `world` as polygons to `path`.

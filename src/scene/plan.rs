@@ -195,6 +195,26 @@ impl Plan {
                 None => "no particle kinds".into(),
             },
         );
+        if let Some(f) = &world.fluid {
+            let [nx, ny, nz] = f.grid.counts();
+            let h = f.grid.cell_size();
+            line(
+                format!(
+                    "fluid: {nx} × {ny} × {nz} cells of {:.4e} × {:.4e} × {:.4e} m, drag {}",
+                    h.x,
+                    h.y,
+                    h.z,
+                    f.model.law.name()
+                ),
+                format!(
+                    "density {} kg/m³, viscosity {} Pa s, shape correction {:?}; solid fraction updated every {} steps ([fluid])",
+                    f.model.properties.density,
+                    f.model.properties.viscosity,
+                    f.model.correction,
+                    spec.fluid.as_ref().map_or(0, |s| s.update_interval)
+                ),
+            );
+        }
         if let Some(d) = &spec.drum {
             line(
                 format!("drum analysis: walls {}", d.walls.join(", ")),
