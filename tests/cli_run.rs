@@ -89,7 +89,8 @@ fn run_writes_the_series_and_the_summary() {
     assert!(candidates <= 27 * 26 / 2, "{candidates}");
     // The time of each stage of the step, in step order; the shares add up to one.
     let stages = summary["stages"].as_array().unwrap();
-    assert_eq!(stages.len(), 7);
+    assert_eq!(stages.len(), 8);
+    assert_eq!(stages[7]["stage"], "fluid");
     assert_eq!(stages[0]["stage"], "integrate");
     let share: f64 = stages.iter().map(|s| s["share"].as_f64().unwrap()).sum();
     assert!((share - 1.0).abs() < 1e-9, "{share}");
