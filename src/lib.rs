@@ -8,8 +8,9 @@
 //!   kernels. It knows nothing of time, forces or scenes.
 //!
 //! - [`contact`]: contact geometry and relative motion to forces and torques.
+//! - [`fluid`]: drag laws, shape corrections and the grid of a coupled fluid.
 //! - [`world`]: particles in flat arrays, body types, materials, walls with their
-//!   motion, inlets.
+//!   motion, inlets, a coupled fluid's field.
 //! - [`engine`]: the CPU time step (broad phase, narrow phase, accumulation,
 //!   integration) and the suggested time step.
 //! - [`analysis`]: figures of a use case read from a running world (the rotating

@@ -173,7 +173,7 @@ fn bench_runs_on_part_of_the_shipped_settled_bed() {
         .split(", ")
         .map(|s| s.rsplit(' ').nth(1).unwrap().parse().unwrap())
         .collect();
-    assert_eq!(shares.len(), 7, "{stages}");
+    assert_eq!(shares.len(), 8, "{stages}");
     assert!(stages.starts_with("integrate") && stages.contains("pair_contacts"));
     assert!((shares.iter().sum::<f64>() - 100.0).abs() < 0.5, "{stages}");
     // A scene that does not exist is named in the error.

@@ -1,8 +1,11 @@
-//! CFD–DEM coupling against closed forms and published correlations: terminal
-//! settling velocities (Stokes, Schiller–Naumann; a cube and a dodecahedron with the
-//! Hölzer–Sommerfeld and Ganser correlations), the momentum given back to the fluid
-//! equal to what the particles received, and the fluid's inputs checked.
-
+//! CFD–DEM coupling against closed forms and published correlations:
+//! - terminal settling velocities: Stokes, Schiller–Naumann, and a cube and a
+//!   dodecahedron under the Hölzer–Sommerfeld and Ganser correlations (each run for
+//!   20–25 relaxation times, so within 1e-5 of the terminal speed);
+//! - the pressure drop across a poured bed against Ergun, and its solid fractions
+//!   against its volume;
+//! - the momentum given back to the fluid equal to what the particles received;
+//! - saved states, `talus run`'s fluid frames, and bad inputs and scene keys.
 use std::path::Path;
 
 use nalgebra::Vector3;
@@ -80,7 +83,11 @@ fn a_sphere_in_creeping_flow_falls_at_stokes_velocity() {
     );
     let stokes = (2500.0 - rho_f) * G * d * d / (18.0 * mu);
     let v = settling_speed(&sim);
-    assert!((v / stokes - 1.0).abs() < 1e-3, "{v} against {stokes}");
+    println!(
+        "Stokes: {v:.6e} m/s against {stokes:.6e} ({:+.1e})",
+        v / stokes - 1.0
+    );
+    assert!((v / stokes - 1.0).abs() < 1e-5, "{v} against {stokes}");
 }
 
 #[test]
@@ -102,7 +109,11 @@ fn a_sphere_at_moderate_reynolds_falls_at_the_schiller_naumann_velocity() {
     let re = rho_f * v_t * d / mu;
     assert!(re > 5.0 && re < 30.0, "Re {re}");
     let v = settling_speed(&sim);
-    assert!((v / v_t - 1.0).abs() < 1e-3, "{v} against {v_t} (Re {re})");
+    println!(
+        "Schiller–Naumann: {v:.6e} m/s against {v_t:.6e} ({:+.1e}, Re {re:.2})",
+        v / v_t - 1.0
+    );
+    assert!((v / v_t - 1.0).abs() < 1e-5, "{v} against {v_t} (Re {re})");
 }
 
 /// The terminal speed of `shape` under Schiller–Naumann with `correction`: the
@@ -134,7 +145,11 @@ fn shaped(shape: &str, correction: ShapeCorrection, name: &str) {
         0.5 * rho_f * area * v * v * cd(rho_f * v * d / mu)
     });
     let v = settling_speed(&sim);
-    assert!((v / v_t - 1.0).abs() < 1e-3, "{name}: {v} against {v_t}");
+    println!(
+        "{name}, ψ {phi:.4}: {v:.6e} m/s against {v_t:.6e} ({:+.1e})",
+        v / v_t - 1.0
+    );
+    assert!((v / v_t - 1.0).abs() < 1e-5, "{name}: {v} against {v_t}");
     // A sphere of the same volume falls faster (by the same correlation).
     let sphere_cd = |re: Real| match correction {
         ShapeCorrection::HolzerSommerfeld => holzer_sommerfeld_cd(re, 1.0, 1.0),
@@ -220,7 +235,7 @@ fn fluid_inputs_of_the_wrong_size_or_not_finite_are_refused() {
     assert_eq!(cells, 128);
     let before = sim.fluid().unwrap().velocity.clone();
     assert_eq!(
-        sim.set_fluid_velocity(&vec![Vector3::zeros(); 5]),
+        sim.set_fluid_velocity(&[Vector3::zeros(); 5]),
         Err(FluidError::Length {
             what: "fluid velocity",
             got: 5,

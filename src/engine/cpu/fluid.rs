@@ -30,8 +30,10 @@ pub(super) fn fluid_forces(world: &mut World, dt: Real, stepped: bool) {
             let Some(local) = field.local(i, p.id[i], &p.position[i], |_, _| ()) else {
                 return (Vector3::zeros(), Vector3::zeros());
             };
-            let kind = p.body_type[i] as usize;
-            let shape = &model.shapes[kind];
+            // Body types are fixed by the scene; one added since has no drag shape.
+            let Some(shape) = model.shapes.get(p.body_type[i] as usize) else {
+                return (Vector3::zeros(), Vector3::zeros());
+            };
             let slip = local.velocity - p.velocity[i];
             let along = slip.try_normalize(0.0).unwrap_or_else(Vector3::z);
             let factor =
