@@ -78,13 +78,14 @@ pub struct FluidSpec {
     /// density × gravity).
     pub pressure_gradient: Option<[Real; 3]>,
     /// Steps between two updates of the particles' volume per cell (the solid
-    /// fraction and the weights of the exchange), default 10.
+    /// fraction and the weights of the exchange), default 50: the coupling interval
+    /// of usual CFD–DEM runs, in which a particle moves a small part of a cell.
     #[serde(default = "default_fluid_update")]
     pub update_interval: u64,
 }
 
 fn default_fluid_update() -> u64 {
-    10
+    50
 }
 
 /// `[bed]`: the tube a bed is packed in, and how the packing is analysed (see
