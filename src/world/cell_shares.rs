@@ -71,6 +71,11 @@ impl CellShares {
             && *starts.last().unwrap() as usize == cells.len()
             && cells.len() == volumes.len()
             && cells.iter().all(|&c| (c as usize) < grid_cells)
+            && starts.windows(2).all(|w| {
+                cells[w[0] as usize..w[1] as usize]
+                    .windows(2)
+                    .all(|c| c[0] < c[1])
+            })
             && volumes.iter().all(|&v| v > 0.0 && v.is_finite());
         if !ok {
             return Err("fluid cell shares are inconsistent".into());
