@@ -5,6 +5,34 @@ use nalgebra::{Point3, Vector3};
 use crate::Real;
 use crate::geometry::cell_volumes::CellBounds;
 
+/// The most cells a grid may have.
+pub const MAX_CELLS: usize = 50_000_000;
+
+/// Why numbers make no grid.
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum GridError {
+    /// A corner that is not finite.
+    #[error("must be finite")]
+    Origin,
+    /// A cell edge that is not positive.
+    #[error("cell sizes must be positive, got {0:?}")]
+    CellSize([Real; 3]),
+    /// No cells along an axis, or too many in all.
+    #[error("cell counts must be at least 1 and at most {MAX_CELLS} in all, got {0:?}")]
+    Counts([usize; 3]),
+}
+
+impl GridError {
+    /// The `[fluid]` key the error is about.
+    pub fn key(&self) -> &'static str {
+        match self {
+            GridError::Origin => "origin",
+            GridError::CellSize(_) => "cell",
+            GridError::Counts(_) => "cells",
+        }
+    }
+}
+
 /// A structured grid of `counts` cells of size `cell` from `origin`.
 ///
 /// # Invariant
@@ -24,20 +52,15 @@ impl FluidGrid {
         origin: Point3<Real>,
         cell: Vector3<Real>,
         counts: [usize; 3],
-    ) -> Result<Self, String> {
+    ) -> Result<Self, GridError> {
         if !origin.coords.iter().all(|x| x.is_finite()) {
-            return Err("the origin must be finite".into());
+            return Err(GridError::Origin);
         }
         if !cell.iter().all(|&h| h > 0.0 && h.is_finite()) {
-            return Err(format!(
-                "cell sizes must be positive, got {:?}",
-                cell.as_slice()
-            ));
+            return Err(GridError::CellSize(cell.into()));
         }
-        if counts.contains(&0) || counts.iter().product::<usize>() > 50_000_000 {
-            return Err(format!(
-                "cell counts must be at least 1 and at most 5e7 in all, got {counts:?}"
-            ));
+        if counts.contains(&0) || counts.iter().product::<usize>() > MAX_CELLS {
+            return Err(GridError::Counts(counts));
         }
         let bounds = std::array::from_fn(|a| {
             (0..=counts[a])

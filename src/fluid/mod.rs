@@ -8,5 +8,5 @@ mod grid;
 pub mod shape;
 
 pub use drag::{DragLaw, FluidProperties, drag_force};
-pub use grid::FluidGrid;
+pub use grid::{FluidGrid, GridError};
 pub use shape::{DragShape, ShapeCorrection};

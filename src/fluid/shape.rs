@@ -7,7 +7,7 @@ use serde::{Deserialize, Serialize};
 
 use super::drag::{DragLaw, schiller_naumann_cd};
 use crate::Real;
-use crate::geometry::Shape;
+use crate::geometry::{Shape, vector_area};
 
 /// A correction of the drag coefficient for non-spherical particles. Under the
 /// single-particle law of Schiller and Naumann the correlation's `C_d` of the shape
@@ -52,14 +52,12 @@ impl DragShape {
             Shape::Sphere(_) => Vec::new(),
             Shape::Polyhedron(p) => (0..p.face_count())
                 .map(|f| {
-                    let v: Vec<_> = p
+                    let face: Vec<_> = p
                         .face(f)
                         .iter()
-                        .map(|&k| p.vertices()[k as usize].coords)
+                        .map(|&k| p.vertices()[k as usize])
                         .collect();
-                    (0..v.len()).fold(Vector3::zeros(), |s, k| {
-                        s + v[k].cross(&v[(k + 1) % v.len()])
-                    }) * 0.5
+                    vector_area(&face)
                 })
                 .collect(),
         };

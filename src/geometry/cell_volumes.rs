@@ -23,7 +23,7 @@ use std::f64::consts::PI;
 use nalgebra::{Point3, Vector3};
 
 use super::quadrature::tanh_sinh;
-use super::{ConvexPolyhedron, Pose};
+use super::{ConvexPolyhedron, Pose, vector_area};
 use crate::Real;
 
 /// Boundaries of the cells along the three axes, each sorted ascending.
@@ -164,13 +164,7 @@ fn volume(faces: &Faces) -> Real {
         / count as Real;
     faces
         .iter()
-        .map(|face| {
-            let o = face[0].coords - centre;
-            let area = face.windows(2).fold(Vector3::zeros(), |s, w| {
-                s + (w[0].coords - centre).cross(&(w[1].coords - centre))
-            }) + (face[face.len() - 1].coords - centre).cross(&o);
-            (0.5 * area).dot(&o).abs() / 3.0
-        })
+        .map(|face| vector_area(face).dot(&(face[0].coords - centre)).abs() / 3.0)
         .sum()
 }
 

@@ -43,6 +43,7 @@ pub use error::GeometryError;
 pub use hull::convex_hull;
 pub use mass::{MassProperties, is_isotropic};
 pub use plane::Plane;
+pub(crate) use polygon::vector_area;
 pub use polyhedron::ConvexPolyhedron;
 pub use rotation::unit_quaternion;
 pub use shape::{Shape, Sphere};

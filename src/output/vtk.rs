@@ -146,7 +146,7 @@ pub fn write_fluid(world: &World, path: &Path) -> io::Result<()> {
     let p = &world.particles;
     let mut drag = vec![nalgebra::Vector3::zeros(); grid.len()];
     for (i, f) in fluid.exchange.drag.iter().enumerate().take(p.owned()) {
-        fluid.local(i, p.id[i], &p.position[i], |c, w| drag[c] += f * w);
+        fluid.weights(i, p.id[i], &p.position[i], |c, w| drag[c] += f * w);
     }
     let vectors = |name: &str, v: &[nalgebra::Vector3<Real>]| Array::F32 {
         name: name.into(),

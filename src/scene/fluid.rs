@@ -11,7 +11,6 @@ use crate::world::{DragModel, FluidField, World};
 /// The fluid field of `spec` over `world` (its body types and gravity set).
 pub(super) fn build_fluid(spec: &FluidSpec, world: &World) -> Result<FluidField, FieldError> {
     let path = FieldPath::root("fluid");
-    finite(path.key("origin"), &spec.origin)?;
     finite(path.key("velocity"), &spec.velocity)?;
     positive(path.key("density"), spec.density)?;
     positive(path.key("viscosity"), spec.viscosity)?;
@@ -26,14 +25,7 @@ pub(super) fn build_fluid(spec: &FluidSpec, world: &World) -> Result<FluidField,
         Vector3::from(spec.cell),
         spec.cells,
     )
-    .map_err(|e| {
-        let key = if e.starts_with("cell sizes") {
-            "cell"
-        } else {
-            "cells"
-        };
-        FieldError::new(path.key(key), e)
-    })?;
+    .map_err(|e| FieldError::new(path.key(e.key()), e.to_string()))?;
     let gradient = match spec.pressure_gradient {
         Some(g) => {
             finite(path.key("pressure_gradient"), &g)?;

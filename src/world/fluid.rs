@@ -120,45 +120,49 @@ impl FluidField {
         }
     }
 
-    /// The fluid at particle `i` (of `id`, at `position`): through its shares when
-    /// they are up to date, else from the cell of its centroid; `None` outside the
-    /// grid. Visits each cell with the particle's weight in it through `cells`.
-    pub fn local(
+    /// Visits each cell particle `i` (of `id`, at `position`) lies in with its weight
+    /// there (its volume in the cell over its volume in the grid): through its shares
+    /// when they are up to date, else the cell of its centroid with weight 1. Visits
+    /// nothing outside the grid. The fluid is read and the drag given back with
+    /// these weights.
+    pub fn weights(
         &self,
         i: usize,
         id: u64,
         position: &Point3<Real>,
-        mut cells: impl FnMut(usize, Real),
-    ) -> Option<LocalFluid> {
-        let one = |c: usize| LocalFluid {
-            voidage: (1.0 - self.solid_fraction[c]).max(0.0),
-            velocity: self.velocity[c],
-            pressure_gradient: self.pressure_gradient[c],
-        };
+        mut visit: impl FnMut(usize, Real),
+    ) {
         match self.shares.of(i, id) {
-            Some((cs, vs)) if !cs.is_empty() => {
-                let total: Real = vs.iter().sum();
-                let mut local = LocalFluid {
-                    voidage: 0.0,
-                    velocity: Vector3::zeros(),
-                    pressure_gradient: Vector3::zeros(),
-                };
-                for (&c, &v) in cs.iter().zip(vs) {
-                    let (w, f) = (v / total, one(c as usize));
-                    local.voidage += w * f.voidage;
-                    local.velocity += f.velocity * w;
-                    local.pressure_gradient += f.pressure_gradient * w;
-                    cells(c as usize, w);
+            Some((cells, volumes)) => {
+                let total: Real = volumes.iter().sum();
+                for (&c, &v) in cells.iter().zip(volumes) {
+                    visit(c as usize, v / total);
                 }
-                Some(local)
             }
-            Some(_) => None,
             None => {
-                let c = self.grid.cell_of(position)?;
-                cells(c, 1.0);
-                Some(one(c))
+                if let Some(c) = self.grid.cell_of(position) {
+                    visit(c, 1.0);
+                }
             }
         }
+    }
+
+    /// The fluid at particle `i`, averaged over its cells by its [`Self::weights`];
+    /// `None` outside the grid.
+    pub fn local(&self, i: usize, id: u64, position: &Point3<Real>) -> Option<LocalFluid> {
+        let mut local = LocalFluid {
+            voidage: 0.0,
+            velocity: Vector3::zeros(),
+            pressure_gradient: Vector3::zeros(),
+        };
+        let mut inside = false;
+        self.weights(i, id, position, |c, w| {
+            inside = true;
+            local.voidage += w * (1.0 - self.solid_fraction[c]).max(0.0);
+            local.velocity += self.velocity[c] * w;
+            local.pressure_gradient += self.pressure_gradient[c] * w;
+        });
+        inside.then_some(local)
     }
 
     /// The mean force the particles put on the fluid in each cell since the last

@@ -27,7 +27,7 @@ pub(super) fn fluid_forces(world: &mut World, dt: Real, stepped: bool) {
         .into_par_iter()
         .with_min_len(PARTICLES_PER_TASK)
         .map(|i| {
-            let Some(local) = field.local(i, p.id[i], &p.position[i], |_, _| ()) else {
+            let Some(local) = field.local(i, p.id[i], &p.position[i]) else {
                 return (Vector3::zeros(), Vector3::zeros());
             };
             // Body types are fixed by the scene; one added since has no drag shape.
@@ -55,7 +55,7 @@ pub(super) fn fluid_forces(world: &mut World, dt: Real, stepped: bool) {
         p.force[i] += drag + pressure;
         fluid.exchange.drag.push(drag);
         if stepped {
-            fluid.local(i, p.id[i], &p.position[i], |c, w| {
+            fluid.weights(i, p.id[i], &p.position[i], |c, w| {
                 impulse[c] += drag * (w * dt)
             });
         }
