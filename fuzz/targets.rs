@@ -419,7 +419,7 @@ pub fn zenoh_messages(data: &[u8]) {
         };
         let before = observe(service.component());
         let ok = pb::Status::Ok as i32;
-        let refused = match which % 5 {
+        let refused = match which % 6 {
             0 => {
                 // A valid step of more than 100 DEM steps is legitimate but slow.
                 if let Ok(request) = pb::StepRequest::decode(payload)
@@ -433,6 +433,7 @@ pub fn zenoh_messages(data: &[u8]) {
             1 => service.walls(payload).status != ok,
             2 => service.info(payload).status != ok,
             3 => service.state(payload).status != ok,
+            5 => service.fluid(payload).status != ok,
             _ => service.forces().is_err(),
         };
         if refused {
@@ -497,6 +498,7 @@ pub fn seeds(target: &str) -> Vec<Vec<u8>> {
                         })),
                     },
                 ],
+                fluid: None,
             };
             let walls = pb::WallsRequest {
                 walls: vec!["box".into(), "lid".into()],

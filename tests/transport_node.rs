@@ -34,19 +34,19 @@ fn query<R: Message + Default>(session: &zenoh::Session, key: &str, payload: Vec
     R::decode(&*sample.payload().to_bytes()).unwrap()
 }
 
-// zenoh needs tokio's multi-threaded runtime.
-#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
-async fn a_client_steps_the_served_drum() {
-    let port = 17300 + (std::process::id() % 90) as u16;
+/// Serves `component` under `key` on a local port from `port_base` (by process, so
+/// parallel test runs do not meet) and opens a client session to it.
+async fn serve(component: Component, key: &str, port_base: u16) -> (Node, zenoh::Session) {
+    let port = port_base + (std::process::id() % 90) as u16;
     let config = NodeConfig {
-        key: "talus/rust-test".into(),
+        key: key.into(),
         listen: vec![format!("tcp/127.0.0.1:{port}")],
         connect: vec![],
         multicast: false,
     };
-    let node = Node::start(Service::new(drum()), &config).unwrap();
+    let node = Node::start(Service::new(component), &config).unwrap();
     let client_config = NodeConfig {
-        key: config.key.clone(),
+        key: key.into(),
         listen: vec![],
         connect: vec![format!("tcp/127.0.0.1:{port}")],
         multicast: false,
@@ -55,6 +55,13 @@ async fn a_client_steps_the_served_drum() {
         .await
         .unwrap();
     tokio::time::sleep(Duration::from_millis(500)).await;
+    (node, session)
+}
+
+// zenoh needs tokio's multi-threaded runtime.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_client_steps_the_served_drum() {
+    let (node, session) = serve(drum(), "talus/rust-test", 17300).await;
 
     let info: pb::InfoReply = query(&session, "talus/rust-test/info", Vec::new());
     assert_eq!(info.status, pb::Status::Ok as i32);
@@ -77,6 +84,7 @@ async fn a_client_steps_the_served_drum() {
                 }),
             })),
         }],
+        fluid: None,
     };
     let reply: pb::StepReply = query(&session, "talus/rust-test/step", request.encode_to_vec());
     direct.set_real_vector(spin, &[0.0, 3.0, 0.0]).unwrap();
@@ -94,4 +102,76 @@ async fn a_client_steps_the_served_drum() {
     session.close().await.unwrap();
     let service = node.stop();
     assert_eq!(service.component().simulation().unwrap().world().time, 0.02);
+}
+
+fn fluid_column() -> Component {
+    let mut c = Component::instantiate(
+        Path::new(env!("CARGO_MANIFEST_DIR")),
+        "tests/scenes/fluid_column.toml",
+    )
+    .unwrap();
+    c.enter_initialization_mode(0.0).unwrap();
+    c.exit_initialization_mode().unwrap();
+    c
+}
+
+/// The fluid over zenoh: a step carries the per-cell inputs, `<key>/fluid` answers
+/// the fields, the same bits as the component driven directly; a request of the
+/// wrong size is refused and changes nothing.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_client_exchanges_the_fluid_fields_with_the_served_column() {
+    let (node, session) = serve(fluid_column(), "talus/fluid-test", 17400).await;
+
+    let velocity: Vec<f64> = (0..54)
+        .flat_map(|c| [0.01 * c as f64, -0.1, 2.5 - 0.02 * c as f64])
+        .collect();
+    let step = |velocity: Vec<f64>| pb::StepRequest {
+        time: 0.0,
+        step: 3e-4,
+        walls: vec![],
+        fluid: Some(pb::FluidInputs {
+            velocity,
+            pressure_gradient: vec![],
+        }),
+    };
+    // The wrong size first: refused, the time and inputs unchanged.
+    let refused: pb::StepReply = query(
+        &session,
+        "talus/fluid-test/step",
+        step(velocity[..9].to_vec()).encode_to_vec(),
+    );
+    assert_eq!(refused.status, pb::Status::Error as i32);
+    assert!(refused.error.contains("162"), "{}", refused.error);
+    let before: pb::FluidReply = query(&session, "talus/fluid-test/fluid", Vec::new());
+    assert_eq!(before.status, pb::Status::Ok as i32, "{}", before.error);
+    assert_eq!(before.time, 0.0);
+    assert!(before.velocity.chunks(3).all(|u| u == [0.0, 0.0, 2.0]));
+
+    let reply: pb::StepReply = query(
+        &session,
+        "talus/fluid-test/step",
+        step(velocity.clone()).encode_to_vec(),
+    );
+    assert_eq!(reply.status, pb::Status::Ok as i32, "{}", reply.error);
+    let fields: pb::FluidReply = query(&session, "talus/fluid-test/fluid", Vec::new());
+
+    let mut direct = fluid_column();
+    let var = direct.variable("fluid.velocity").unwrap();
+    direct.set_real_vector(var, &velocity).unwrap();
+    direct.do_step(0.0, 3e-4).unwrap();
+    let read = |name: &str| {
+        direct
+            .get_real_vector(direct.variable(name).unwrap())
+            .unwrap()
+    };
+    let grid = fields.grid.as_ref().unwrap();
+    assert_eq!(grid.counts, [3, 3, 6]);
+    assert_eq!(grid.cell.unwrap().z, 0.01);
+    assert_eq!(fields.velocity, velocity);
+    assert_eq!(fields.momentum_source, read("fluid.momentum_source"));
+    assert_eq!(fields.solid_fraction, read("fluid.solid_fraction"));
+    assert_eq!(fields.particle_velocity, read("fluid.particle_velocity"));
+    assert!(fields.momentum_source.iter().any(|&f| f != 0.0));
+    session.close().await.unwrap();
+    node.stop();
 }

@@ -178,6 +178,18 @@ int talus_get_facet_forces(struct talus_component *handle,
                            double *forces,
                            size_t n_triangles);
 
+// The fluid grid of a scene with `[fluid]`: the lower corner of its first cell, the
+// cell edges and the cell counts along x, y and z (3 values each). Per-cell arrays
+// (`fluid.velocity`, `fluid.solid_fraction` ...; see `talus_get_real`) run x fastest,
+// then y, then z, with x y z per cell for vectors.
+//
+// # Safety
+// `handle` is a live component; `origin`, `cell` and `counts` have room for 3 values.
+int talus_get_fluid_grid(struct talus_component *handle,
+                         double *origin,
+                         double *cell,
+                         size_t *counts);
+
 // Reads the `n` values of the real variable called `name`.
 //
 // # Safety

@@ -100,11 +100,17 @@ class Client:
         req = self.pb.WallsRequest(walls=list(names), facet_forces=facet_forces)
         return self._query("walls", req, self.pb.WallsReply)
 
-    def step(self, time, step, walls=None, check=True):
+    def step(self, time, step, walls=None, check=True, fluid_velocity=None, pressure_gradient=None):
         """Steps from `time` by `step`. `walls` maps a wall name to
         {"velocity": (x, y, z), "angular_velocity": (x, y, z)} or
-        {"position": (x, y, z), "orientation": (w, x, y, z)}."""
+        {"position": (x, y, z), "orientation": (w, x, y, z)}. `fluid_velocity` and
+        `pressure_gradient` (scenes with [fluid]): x y z per cell, flat, in the grid's
+        order; None leaves the input as it was."""
         req = self.pb.StepRequest(time=time, step=step)
+        if fluid_velocity is not None:
+            req.fluid.velocity.extend(float(x) for x in fluid_velocity)
+        if pressure_gradient is not None:
+            req.fluid.pressure_gradient.extend(float(x) for x in pressure_gradient)
         for name, motion in (walls or {}).items():
             m = req.walls.add(wall=name)
             if "position" in motion or "orientation" in motion:
@@ -119,6 +125,10 @@ class Client:
                 m.velocity.linear.x, m.velocity.linear.y, m.velocity.linear.z = v
                 m.velocity.angular.x, m.velocity.angular.y, m.velocity.angular.z = w
         return self._query("step", req, self.pb.StepReply, check)
+
+    def fluid(self):
+        """The fluid's grid and per-cell fields (FluidReply)."""
+        return self._query("fluid", self.pb.FluidRequest(), self.pb.FluidReply)
 
     def save(self):
         return self._query("state", self.pb.StateRequest(save=True), self.pb.StateReply).state

@@ -4,6 +4,8 @@
 use super::component::{Component, Mode, RUNNING, WallDrive, fingerprint};
 use super::variables::{Causality, Role, VarType, Variable, variable_table};
 use super::{CosimError, VarRef};
+use nalgebra::Vector3;
+
 use crate::Real;
 use crate::scene::{MAX_THREADS, Scene};
 
@@ -96,6 +98,7 @@ impl Component {
     fn real_value(&self, role: Role, k: usize) -> Real {
         let drive = |w: usize| &self.drives[w];
         let sim = self.sim.as_ref();
+        let fluid = sim.and_then(|s| s.fluid());
         match role {
             Role::Time => sim.map_or(0.0, |s| s.world().time),
             Role::TimeStep => self.params.dt,
@@ -140,8 +143,65 @@ impl Component {
                     .map_or(0.0, |(h, e)| if role == Role::BedHeight { h } else { e }),
                 _ => 0.0,
             },
+            Role::FluidVelocity | Role::PressureGradient => {
+                self.fluid_input(role).map_or(0.0, |x| x[k / 3][k % 3])
+            }
+            Role::SolidFraction => fluid.map_or(0.0, |f| f.solid_fraction[k]),
+            Role::ParticleVelocity => fluid.map_or(0.0, |f| f.particle_velocity[k / 3][k % 3]),
+            Role::MomentumSource => fluid.map_or(0.0, |f| f.momentum_source(k / 3)[k % 3]),
             Role::Scene | Role::OutputDir | Role::Threads | Role::Particles | Role::Contacts => {
                 unreachable!("not a real variable")
+            }
+        }
+    }
+
+    /// The fluid's velocity or pressure gradient per cell: the simulation's once it
+    /// exists, the start values before.
+    fn fluid_input(&self, role: Role) -> Option<&[Vector3<Real>]> {
+        let (velocity, gradient) = match (&self.sim, &self.fluid_start) {
+            (Some(sim), _) => {
+                let f = sim.fluid()?;
+                (&f.velocity, &f.pressure_gradient)
+            }
+            (None, Some(start)) => (&start.velocity, &start.pressure_gradient),
+            (None, None) => return None,
+        };
+        Some(if role == Role::FluidVelocity {
+            velocity
+        } else {
+            gradient
+        })
+    }
+
+    /// Applies elements set of the fluid's inputs, `(role, element, value)`, checked.
+    fn set_fluid_inputs(&mut self, edits: &[(Role, usize, Real)]) {
+        if edits.is_empty() {
+            return;
+        }
+        let (Some(velocity), Some(gradient)) = (
+            self.fluid_input(Role::FluidVelocity),
+            self.fluid_input(Role::PressureGradient),
+        ) else {
+            unreachable!("fluid variables exist only with a fluid")
+        };
+        let (mut velocity, mut gradient) = (velocity.to_vec(), gradient.to_vec());
+        for &(role, k, x) in edits {
+            let field = if role == Role::FluidVelocity {
+                &mut velocity
+            } else {
+                &mut gradient
+            };
+            field[k / 3][k % 3] = x;
+        }
+        match &mut self.sim {
+            Some(sim) => sim
+                .set_fluid_velocity(&velocity)
+                .and_then(|()| sim.set_pressure_gradient(&gradient))
+                .expect("checked finite, sized by the variable table"),
+            None => {
+                let start = self.fluid_start.as_mut().expect("a fluid");
+                start.velocity = velocity;
+                start.pressure_gradient = gradient;
             }
         }
     }
@@ -183,6 +243,7 @@ impl Component {
             }
         }
         let mut drives = self.drives.clone();
+        let mut fluid = Vec::new();
         for (r, x) in refs.iter().zip(values) {
             let role = self.variables[r.var].role;
             let k = r.element;
@@ -213,9 +274,11 @@ impl Component {
                         orientation[k] = *x;
                     }
                 }
+                Role::FluidVelocity | Role::PressureGradient => fluid.push((role, k, *x)),
                 _ => unreachable!("checked writable above"),
             }
         }
+        self.set_fluid_inputs(&fluid);
         // A quaternion is checked when it is used (a master sets its elements one by
         // one): a zero quaternion at a step is an error there.
         self.drives = drives;

@@ -104,6 +104,24 @@ pub struct WallMesh<'a> {
     pub triangles: &'a [[u32; 3]],
 }
 
+/// The fluid's inputs per cell as the master set them before the simulation exists
+/// (from then on they live in the simulation's fluid field).
+#[derive(Clone, Debug, PartialEq)]
+pub(super) struct FluidInputs {
+    pub(super) velocity: Vec<Vector3<Real>>,
+    pub(super) pressure_gradient: Vec<Vector3<Real>>,
+}
+
+impl FluidInputs {
+    /// The scene's start values, with a `[fluid]` section.
+    fn of(scene: &Scene) -> Option<Self> {
+        scene.world.fluid.as_ref().map(|f| FluidInputs {
+            velocity: f.velocity.clone(),
+            pressure_gradient: f.pressure_gradient.clone(),
+        })
+    }
+}
+
 /// Parameters a master may change before the simulation runs.
 #[derive(Clone, Debug, PartialEq)]
 pub(super) struct Parameters {
@@ -124,6 +142,8 @@ pub struct Component {
     pub(super) params: Parameters,
     pub(super) drives: Vec<WallDrive>,
     pub(super) means: Vec<WallMeans>,
+    /// The fluid's inputs until initialisation starts.
+    pub(super) fluid_start: Option<FluidInputs>,
     pub(super) sim: Option<Simulation>,
     pub(super) pool: Option<JoinedPool>,
     pub(super) output: Option<RunOutput>,
@@ -175,6 +195,7 @@ impl Component {
             start,
             means: vec![WallMeans::default(); drives.len()],
             drives,
+            fluid_start: FluidInputs::of(&scene),
             scene,
             sim: None,
             pool: None,
@@ -264,6 +285,11 @@ impl Component {
         let mut sim = pool.install(|| Simulation::new(&self.scene));
         sim.set_time_step(self.params.dt);
         sim.set_time(start_time);
+        if let Some(start) = &self.fluid_start {
+            sim.set_fluid_velocity(&start.velocity)
+                .and_then(|()| sim.set_pressure_gradient(&start.pressure_gradient))
+                .expect("the start values were checked when set");
+        }
         self.pool = Some(pool);
         self.sim = Some(sim);
         self.means = vec![WallMeans::default(); self.drives.len()];
@@ -377,6 +403,8 @@ impl Component {
         let pool = self.pool.as_ref().expect("a running component has a pool");
         // Rollback through the saved state, not a copy of the whole simulation.
         let before = sim.snapshot();
+        // The momentum source is the mean over this step.
+        sim.restart_fluid_exchange();
         let balance = EnergyBalance::start(sim);
         // A start within round-off before the component's time must not take the
         // clock back.
@@ -494,6 +522,7 @@ impl Component {
         self.params = self.start.clone();
         self.drives = initial_drives(&self.scene);
         self.means = vec![WallMeans::default(); self.drives.len()];
+        self.fluid_start = FluidInputs::of(&self.scene);
         self.mode = Mode::Instantiated;
     }
 
@@ -507,6 +536,17 @@ impl Component {
             vertices: wall.vertices.iter().map(|v| wall.pose * v).collect(),
             triangles: &wall.triangles,
         })
+    }
+
+    /// The grid of the scene's coupled fluid, whose cells the `fluid.*` arrays
+    /// follow; an error that says so without a `[fluid]` section.
+    pub fn fluid_grid(&self) -> Result<&crate::fluid::FluidGrid, CosimError> {
+        self.scene
+            .world
+            .fluid
+            .as_ref()
+            .map(|f| &f.grid)
+            .ok_or(CosimError::NoFluid)
     }
 
     /// Index of the wall called `name`.

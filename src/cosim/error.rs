@@ -41,6 +41,9 @@ pub enum CosimError {
         /// What is wrong.
         problem: String,
     },
+    /// A fluid call on a scene without `[fluid]`.
+    #[error("the scene has no [fluid] section")]
+    NoFluid,
     /// A communication step that cannot be taken.
     #[error("step refused: {0}")]
     BadStep(String),

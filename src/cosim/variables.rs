@@ -99,7 +99,23 @@ pub enum Role {
     BedHeight,
     /// Output: bed-averaged porosity at the end of the step.
     BedPorosity,
+    /// Input per fluid cell: the fluid's (interstitial) velocity.
+    FluidVelocity,
+    /// Input per fluid cell: the pressure gradient.
+    PressureGradient,
+    /// Output per fluid cell: the solid volume fraction at the last update.
+    SolidFraction,
+    /// Output per fluid cell: the mean particle velocity at the last update.
+    ParticleVelocity,
+    /// Output per fluid cell: the mean force of the particles on the fluid over the
+    /// last step.
+    MomentumSource,
 }
+
+/// The most fluid cells whose variables the FMI 2.0 face offers as scalars (13 per
+/// cell); a larger grid's are left out there (FMI 3.0, the C and Rust APIs and zenoh
+/// carry them as arrays).
+pub const FMI2_MAX_FLUID_CELLS: usize = 1000;
 
 /// One variable.
 #[derive(Clone, Debug, PartialEq)]
@@ -331,6 +347,9 @@ pub fn variable_table(scene: &Scene) -> Vec<Variable> {
                 ),
         ]);
     }
+    if let Some(fluid) = &scene.world.fluid {
+        v.extend(fluid_variables(fluid.grid.len()));
+    }
     v.extend([
         Variable::new("particles".into(), Role::Particles, Output, 1)
             .typed(VarType::Integer)
@@ -348,6 +367,69 @@ pub fn variable_table(scene: &Scene) -> Vec<Variable> {
     v
 }
 
+/// The variables of a fluid grid of `cells` cells, flat in the grid's order (x
+/// fastest), x y z per cell for vectors.
+fn fluid_variables(cells: usize) -> Vec<Variable> {
+    use Causality::*;
+    let per_cell = [
+        (
+            "fluid.velocity",
+            Role::FluidVelocity,
+            Input,
+            3,
+            "m/s",
+            "Fluid (interstitial) velocity per cell, x y z per cell, held over the step",
+        ),
+        (
+            "fluid.pressure_gradient",
+            Role::PressureGradient,
+            Input,
+            3,
+            "Pa/m",
+            "Pressure gradient per cell, x y z per cell, held over the step (start: \
+             hydrostatic or the scene's)",
+        ),
+        (
+            "fluid.solid_fraction",
+            Role::SolidFraction,
+            Output,
+            1,
+            "1",
+            "Solid volume fraction per cell (exact clipped particle volumes) at the last \
+             update of the shares",
+        ),
+        (
+            "fluid.particle_velocity",
+            Role::ParticleVelocity,
+            Output,
+            3,
+            "m/s",
+            "Volume-weighted mean particle velocity per cell, x y z per cell, at the last \
+             update of the shares",
+        ),
+        (
+            "fluid.momentum_source",
+            Role::MomentumSource,
+            Output,
+            3,
+            "N",
+            "Mean force of the particles on the fluid per cell over the last step (minus \
+             the drag they received; divide by the cell volume for a source density), x y \
+             z per cell",
+        ),
+    ];
+    per_cell
+        .into_iter()
+        .map(|(name, role, causality, width, unit, about)| {
+            let mut var = Variable::new(name.into(), role, causality, width * cells)
+                .unit(unit)
+                .about(about);
+            var.array_only = cells > FMI2_MAX_FLUID_CELLS;
+            var
+        })
+        .collect()
+}
+
 /// A unit used by the table, as SI base-unit exponents (kg, m, s, rad).
 pub fn unit_exponents(unit: &str) -> [i32; 4] {
     match unit {
@@ -360,6 +442,7 @@ pub fn unit_exponents(unit: &str) -> [i32; 4] {
         "N.m" => [1, 2, -2, 0],
         "J" => [1, 2, -2, 0],
         "W" => [1, 2, -3, 0],
+        "Pa/m" => [1, -2, -2, 0],
         _ => [0, 0, 0, 0],
     }
 }

@@ -443,6 +443,37 @@ pub unsafe extern "C" fn talus_get_facet_forces(
     })
 }
 
+/// The fluid grid of a scene with `[fluid]`: the lower corner of its first cell, the
+/// cell edges and the cell counts along x, y and z (3 values each). Per-cell arrays
+/// (`fluid.velocity`, `fluid.solid_fraction` ...; see `talus_get_real`) run x fastest,
+/// then y, then z, with x y z per cell for vectors.
+///
+/// # Safety
+/// `handle` is a live component; `origin`, `cell` and `counts` have room for 3 values.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn talus_get_fluid_grid(
+    handle: *mut TalusComponent,
+    origin: *mut f64,
+    cell: *mut f64,
+    counts: *mut usize,
+) -> c_int {
+    with(handle, |h| {
+        let grid = h.component.fluid_grid().map_err(|e| e.to_string())?;
+        // Every pointer checked before any is written.
+        let (o, c, n) = unsafe {
+            (
+                slice_mut(origin, 3, "origin")?,
+                slice_mut(cell, 3, "cell")?,
+                slice_mut(counts, 3, "counts")?,
+            )
+        };
+        o.copy_from_slice(grid.origin().coords.as_slice());
+        c.copy_from_slice(grid.cell_size().as_slice());
+        n.copy_from_slice(&grid.counts());
+        Ok(())
+    })
+}
+
 /// Reads the `n` values of the real variable called `name`.
 ///
 /// # Safety

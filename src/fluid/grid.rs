@@ -85,6 +85,11 @@ impl FluidGrid {
         self.len() == 0
     }
 
+    /// The lower corner of cell `[0, 0, 0]`.
+    pub fn origin(&self) -> Point3<Real> {
+        self.origin
+    }
+
     /// Cells along each axis.
     pub fn counts(&self) -> [usize; 3] {
         self.counts

@@ -173,10 +173,15 @@ pub fn fmi2(c: &Component, model: &str) -> String {
     let _ = writeln!(out, "  <ModelVariables>");
     let scalars = fmi2_scalars(c.variables());
     let mut outputs = Vec::new();
+    // Each variable's start values once, not once per element (a fluid grid's
+    // velocity has thousands).
+    let mut starts: (usize, Option<Vec<String>>) = (usize::MAX, None);
     for (vr, (r, name)) in scalars.iter().enumerate() {
         let v = &c.variables()[r.var];
-        let starts = start(c, r.var);
-        let start = starts.as_ref().map(|s| s[r.element].clone());
+        if starts.0 != r.var {
+            starts = (r.var, start(c, r.var));
+        }
+        let start = starts.1.as_ref().map(|s| s[r.element].clone());
         let _ = write!(out, "    <ScalarVariable {}>", attributes(v, vr, name));
         let ty = match v.ty {
             VarType::Real => "Real",

@@ -64,6 +64,9 @@ pub struct FmuSummary {
     pub resources: Vec<PathBuf>,
     /// Archive size in bytes.
     pub bytes: usize,
+    /// Variables the description leaves out (FMI 2.0 has no arrays: wall meshes and
+    /// a large fluid grid's fields), by name.
+    pub left_out: Vec<String>,
 }
 
 /// Files a scene names, with the field that names each.
@@ -173,6 +176,15 @@ pub fn write_fmu(
         variables: component.variables().len(),
         resources: resources.into_iter().map(|r| r.0).collect(),
         bytes: archive.len(),
+        left_out: match version {
+            FmiVersion::Two => component
+                .variables()
+                .iter()
+                .filter(|v| v.array_only)
+                .map(|v| v.name.clone())
+                .collect(),
+            FmiVersion::Three => Vec::new(),
+        },
     })
 }
 

@@ -68,6 +68,16 @@ impl Simulation {
         Ok(fluid.take_momentum_source())
     }
 
+    /// Starts the sums of the momentum exchange again: a coupled master does it at
+    /// the start of each communication step, so that
+    /// [`FluidField::momentum_source`] is the mean over that step.
+    pub fn restart_fluid_exchange(&mut self) {
+        if let Some(fluid) = self.world.fluid.as_mut() {
+            fluid.restart_exchange();
+            self.backend.fluid_changed(&self.world);
+        }
+    }
+
     fn set_cells(
         &mut self,
         what: &'static str,

@@ -116,6 +116,29 @@ impl Service {
                 }
             }
         }
+        if let Some(fluid) = &request.fluid {
+            for (name, given) in [
+                ("fluid.velocity", &fluid.velocity),
+                ("fluid.pressure_gradient", &fluid.pressure_gradient),
+            ] {
+                if given.is_empty() {
+                    continue;
+                }
+                let var = self
+                    .component
+                    .variable(name)
+                    .map_err(|_| "the scene has no [fluid] section".to_string())?;
+                let size = self.component.variables()[var].size;
+                if given.len() != size {
+                    return Err(format!(
+                        "{name}: {} values, the grid takes {size} (x y z per cell)",
+                        given.len()
+                    ));
+                }
+                refs.extend((0..size).map(|element| VarRef { var, element }));
+                values.extend_from_slice(given);
+            }
+        }
         // Inputs are set all or none, and put back if the step is refused.
         let mut previous = vec![0.0; refs.len()];
         self.component
@@ -298,6 +321,36 @@ impl Service {
             variables,
             talus_version: env!("CARGO_PKG_VERSION").into(),
         }
+    }
+
+    /// `<key>/fluid`: the grid and the per-cell fields of a coupled fluid.
+    pub fn fluid(&self, payload: &[u8]) -> pb::FluidReply {
+        let result = (|| {
+            pb::FluidRequest::decode(payload)
+                .map_err(|e| format!("malformed FluidRequest: {e}"))?;
+            let grid = self.component.fluid_grid().map_err(|e| e.to_string())?;
+            Ok::<_, String>(pb::FluidReply {
+                status: pb::Status::Ok as i32,
+                error: String::new(),
+                time: self.time(),
+                grid: Some(pb::FluidGrid {
+                    origin: Some(vec3(grid.origin().coords.as_slice())),
+                    cell: Some(vec3(grid.cell_size().as_slice())),
+                    counts: grid.counts().iter().map(|&n| n as u32).collect(),
+                }),
+                solid_fraction: self.vector("fluid.solid_fraction")?,
+                particle_velocity: self.vector("fluid.particle_velocity")?,
+                momentum_source: self.vector("fluid.momentum_source")?,
+                velocity: self.vector("fluid.velocity")?,
+                pressure_gradient: self.vector("fluid.pressure_gradient")?,
+            })
+        })();
+        result.unwrap_or_else(|error| pb::FluidReply {
+            status: pb::Status::Error as i32,
+            error,
+            time: self.time(),
+            ..Default::default()
+        })
     }
 
     /// `<key>/state`: save (the bytes come back) or restore.

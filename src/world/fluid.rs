@@ -165,22 +165,30 @@ impl FluidField {
         inside.then_some(local)
     }
 
-    /// The mean force the particles put on the fluid in each cell since the last
-    /// call (minus the drag they received, averaged over the time), which starts
-    /// the sums again. Zero when no time passed.
-    pub fn take_momentum_source(&mut self) -> Vec<Vector3<Real>> {
+    /// The mean force the particles put on cell `c` of the fluid since the sums were
+    /// last started (minus the drag they received there, averaged over the time);
+    /// zero when no time passed.
+    pub fn momentum_source(&self, c: usize) -> Vector3<Real> {
         let t = self.exchange.elapsed;
-        let out = self
-            .exchange
-            .impulse
-            .iter_mut()
-            .map(|j| {
-                let f = if t > 0.0 { -*j / t } else { Vector3::zeros() };
-                *j = Vector3::zeros();
-                f
-            })
-            .collect();
+        if t > 0.0 {
+            -self.exchange.impulse[c] / t
+        } else {
+            Vector3::zeros()
+        }
+    }
+
+    /// Starts the sums of the exchange again.
+    pub fn restart_exchange(&mut self) {
+        self.exchange.impulse.fill(Vector3::zeros());
         self.exchange.elapsed = 0.0;
+    }
+
+    /// The [`Self::momentum_source`] of every cell, and starts the sums again.
+    pub fn take_momentum_source(&mut self) -> Vec<Vector3<Real>> {
+        let out = (0..self.grid.len())
+            .map(|c| self.momentum_source(c))
+            .collect();
+        self.restart_exchange();
         out
     }
 }

@@ -7,24 +7,7 @@
 
 #include "talus.h"
 
-static int failures = 0;
-
-#define CHECK(cond, what)                                                   \
-    do {                                                                    \
-        if (!(cond)) {                                                      \
-            fprintf(stderr, "FAILED: %s (line %d): %s\n", what, __LINE__,  \
-                    talus_last_error());                                    \
-            ++failures;                                                     \
-        }                                                                   \
-    } while (0)
-
-#define REFUSED(call, words)                                                \
-    do {                                                                    \
-        int s_ = (call);                                                    \
-        CHECK(s_ == TALUS_ERROR, #call " must fail");                       \
-        CHECK(strstr(talus_last_error(), words) != NULL,                    \
-              #call " must say '" words "'");                               \
-    } while (0)
+#include "check.h"
 
 int main(int argc, char **argv) {
     if (argc < 2) return 2;

@@ -12,6 +12,7 @@ SCENES = {
     "drum": ROOT / "examples" / "drum_fmu" / "drum.toml",
     "empty_drum": ROOT / "examples" / "drum_fmu" / "empty_drum.toml",
     "tube": ROOT / "tests" / "scenes" / "tube_bed.toml",
+    "fluid": ROOT / "tests" / "scenes" / "fluid_column.toml",
 }
 
 

@@ -35,7 +35,7 @@ def torque_y(result, version):
 
 
 @pytest.mark.parametrize("version", [2, 3])
-@pytest.mark.parametrize("scene", ["drum", "tube"])
+@pytest.mark.parametrize("scene", ["drum", "tube", "fluid"])
 def test_fmpy_validation_finds_no_problem(fmus, scene, version):
     assert validate_fmu(str(fmus[(scene, version)])) == []
 

@@ -190,3 +190,37 @@ def test_sigterm_stops_the_node_cleanly_with_its_outputs(drum_server, proto_dir)
     walls = (drum_server.out / "walls.csv").read_text().splitlines()
     assert walls[0].startswith("time,drum_fx") and len(walls) >= 7
     assert (drum_server.out / "particles.pvd").is_file()
+
+
+def test_the_fluid_fields_over_zenoh_equal_the_c_apis(tmp_path, proto_dir):
+    server = Server(SCENES["fluid"], tmp_path / "out")
+    try:
+        with server.client(proto_dir) as client:
+            lib = ctypes.CDLL(str(TALUS.with_name("libtalus.so")))
+            lib.talus_create.restype = ctypes.c_void_p
+            handle = ctypes.c_void_p(lib.talus_create(str(SCENES["fluid"]).encode()))
+            assert handle.value and lib.talus_initialize(handle, ctypes.c_double(0.0)) == 0
+            cells = 54
+            t, h = 0.0, 3e-4
+            for k in range(2):
+                u = [x for c in range(cells) for x in (0.01 * c, -0.1 * k, 2.5 - 0.02 * c)]
+                client.step(t, h, fluid_velocity=u)
+                assert lib.talus_set_real(handle, b"fluid.velocity", (ctypes.c_double * len(u))(*u),
+                                          ctypes.c_size_t(len(u))) == 0
+                assert lib.talus_step(handle, ctypes.c_double(t), ctypes.c_double(h)) == 0
+                t += h
+            fields = client.fluid()
+            assert list(fields.grid.counts) == [3, 3, 6] and fields.time == t
+            for name, size in [("momentum_source", 3 * cells), ("solid_fraction", cells),
+                               ("particle_velocity", 3 * cells), ("velocity", 3 * cells)]:
+                out = (ctypes.c_double * size)()
+                assert lib.talus_get_real(handle, f"fluid.{name}".encode(), out,
+                                          ctypes.c_size_t(size)) == 0
+                assert list(getattr(fields, name)) == list(out), name
+            assert sum(fields.momentum_source[2::3]) < 0.0
+            with pytest.raises(TalusError, match="162"):
+                client.step(t, h, fluid_velocity=[1.0, 2.0])
+            assert client.fluid().time == t
+            lib.talus_free(handle)
+    finally:
+        assert server.stop() == 0

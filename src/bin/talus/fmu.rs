@@ -40,5 +40,13 @@ pub fn fmu(scene: &Path, output: &Path, fmi: u8, library: Option<PathBuf>) -> Re
         summary.resources.len(),
         summary.bytes as f64 / 1e6
     );
+    if !summary.left_out.is_empty() {
+        println!(
+            "note: FMI 2.0 has no arrays; left out: {} (FMI 3.0, the C API and zenoh carry \
+             them; fluid grids of at most {} cells are offered as FMI 2.0 scalars)",
+            summary.left_out.join(", "),
+            talus::cosim::variables::FMI2_MAX_FLUID_CELLS
+        );
+    }
     Ok(())
 }

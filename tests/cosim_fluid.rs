@@ -1,0 +1,238 @@
+//! A coupled fluid on the co-simulation component: its variables sized by the grid,
+//! the same numbers as the simulation driven directly, inputs set all or none, the
+//! momentum source the mean over each communication step, and saved states.
+
+use std::ops::ControlFlow;
+use std::path::Path;
+
+use nalgebra::Vector3;
+use talus::Real;
+use talus::cosim::{Causality, Component, CosimError, VarRef, variables::FMI2_MAX_FLUID_CELLS};
+use talus::fmi::fmi2_scalars;
+use talus::scene::{Scene, Simulation};
+
+const SCENE: &str = "tests/scenes/fluid_column.toml";
+
+fn root() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn column() -> Component {
+    Component::instantiate(root(), SCENE).unwrap()
+}
+
+fn vector(c: &Component, name: &str) -> Vec<Real> {
+    c.get_real_vector(c.variable(name).unwrap()).unwrap()
+}
+
+fn set(c: &mut Component, name: &str, values: &[Real]) -> Result<(), CosimError> {
+    let var = c.variable(name).unwrap();
+    c.set_real_vector(var, values)
+}
+
+/// A fluid velocity differing from cell to cell, x y z per cell.
+fn swirl(cells: usize, phase: Real) -> Vec<Real> {
+    (0..cells)
+        .flat_map(|c| {
+            let c = c as Real;
+            [
+                0.3 * (c + phase).sin(),
+                -0.2 * (0.5 * c).cos(),
+                2.0 + 0.05 * c + phase,
+            ]
+        })
+        .collect()
+}
+
+fn vec3s(flat: &[Real]) -> Vec<Vector3<Real>> {
+    flat.chunks_exact(3)
+        .map(Vector3::from_column_slice)
+        .collect()
+}
+
+#[test]
+fn the_fluid_variables_are_sized_by_the_grid_with_their_start_values() {
+    let c = column();
+    let cells = 54;
+    let expect = [
+        ("fluid.velocity", Causality::Input, 3, "m/s"),
+        ("fluid.pressure_gradient", Causality::Input, 3, "Pa/m"),
+        ("fluid.solid_fraction", Causality::Output, 1, "1"),
+        ("fluid.particle_velocity", Causality::Output, 3, "m/s"),
+        ("fluid.momentum_source", Causality::Output, 3, "N"),
+    ];
+    for (name, causality, width, unit) in expect {
+        let v = &c.variables()[c.variable(name).unwrap()];
+        assert_eq!(
+            (v.causality, v.size, v.unit, v.array_only),
+            (causality, width * cells, Some(unit), false),
+            "{name}"
+        );
+    }
+    // Start values: the scene's velocity, the hydrostatic gradient.
+    let u = vector(&c, "fluid.velocity");
+    let g = vector(&c, "fluid.pressure_gradient");
+    for cell in 0..cells {
+        assert_eq!(&u[3 * cell..3 * cell + 3], &[0.0, 0.0, 2.0]);
+        assert_eq!(&g[3 * cell..3 * cell + 3], &[0.0, 0.0, -9.81 * 1.2]);
+    }
+    // FMI 2.0 offers the small grid's 13 values per cell as scalars.
+    let scalars = fmi2_scalars(c.variables());
+    let fluid = scalars
+        .iter()
+        .filter(|(_, n)| n.starts_with("fluid."))
+        .count();
+    assert_eq!(fluid, 13 * cells);
+    assert!(
+        scalars
+            .iter()
+            .any(|(_, n)| n == "fluid.momentum_source[162]")
+    );
+
+    // A grid of more cells than FMI 2.0 takes: arrays only.
+    let text = std::fs::read_to_string(root().join(SCENE))
+        .unwrap()
+        .replace("cells = [3, 3, 6]", "cells = [11, 10, 10]");
+    let dir = std::env::temp_dir().join(format!("talus-cosim-fluid-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("big.toml"), text).unwrap();
+    let big = Component::instantiate(&dir, "big.toml").unwrap();
+    let _ = std::fs::remove_dir_all(&dir);
+    const { assert!(1100 > FMI2_MAX_FLUID_CELLS) };
+    let v = &big.variables()[big.variable("fluid.velocity").unwrap()];
+    assert_eq!((v.size, v.array_only), (3300, true));
+    assert!(
+        fmi2_scalars(big.variables())
+            .iter()
+            .all(|(_, n)| !n.starts_with("fluid."))
+    );
+}
+
+/// The component against the simulation stepped by hand: the same inputs give the
+/// same bits of every fluid output, and the momentum source is the mean over the
+/// last communication step alone.
+#[test]
+fn the_component_hands_over_what_the_simulation_computes() {
+    let mut c = column();
+    let cells = 54;
+    let first = swirl(cells, 0.0);
+    set(&mut c, "fluid.velocity", &first).unwrap();
+    c.enter_initialization_mode(0.0).unwrap();
+    c.exit_initialization_mode().unwrap();
+    assert!(
+        vector(&c, "fluid.momentum_source")
+            .iter()
+            .all(|&x| x == 0.0),
+        "no step yet: no mean"
+    );
+
+    let scene = Scene::load(&root().join(SCENE)).unwrap();
+    let mut sim = Simulation::new(&scene);
+    sim.set_fluid_velocity(&vec3s(&first)).unwrap();
+    sim.initialise();
+
+    let h = 13.0 * sim.dt();
+    let second = swirl(cells, 0.7);
+    for (k, input) in [&first, &second].into_iter().enumerate() {
+        set(&mut c, "fluid.velocity", input).unwrap();
+        c.do_step(k as Real * h, h).unwrap();
+        sim.set_fluid_velocity(&vec3s(input)).unwrap();
+        sim.restart_fluid_exchange();
+        let _ = sim.advance_to((k + 1) as Real * h, |_, _| ControlFlow::<()>::Continue(()));
+        let source: Vec<Real> = sim
+            .take_momentum_source()
+            .unwrap()
+            .iter()
+            .flat_map(|f| [f.x, f.y, f.z])
+            .collect();
+        let fluid = sim.fluid().unwrap();
+        assert_eq!(vector(&c, "fluid.momentum_source"), source, "step {k}");
+        assert_eq!(vector(&c, "fluid.solid_fraction"), fluid.solid_fraction);
+        let mean: Vec<Real> = fluid
+            .particle_velocity
+            .iter()
+            .flat_map(|u| [u.x, u.y, u.z])
+            .collect();
+        assert_eq!(vector(&c, "fluid.particle_velocity"), mean);
+    }
+    // The gas lifts: the particles push down on it, and the solid fills cells.
+    let source = vector(&c, "fluid.momentum_source");
+    let down: Real = source.chunks_exact(3).map(|f| f[2]).sum();
+    assert!(
+        down < 0.0,
+        "the particles take momentum from the gas: {down}"
+    );
+    let solid: Real = vector(&c, "fluid.solid_fraction").iter().sum();
+    assert!(solid > 0.5, "{solid}");
+}
+
+#[test]
+fn bad_fluid_inputs_are_refused_and_change_nothing() {
+    let mut c = column();
+    c.enter_initialization_mode(0.0).unwrap();
+    c.exit_initialization_mode().unwrap();
+    let before = vector(&c, "fluid.pressure_gradient");
+    let mut bad = swirl(54, 0.0);
+    bad[100] = Real::NAN;
+    let err = set(&mut c, "fluid.pressure_gradient", &bad).unwrap_err();
+    assert!(
+        err.to_string().contains("fluid.pressure_gradient") && err.to_string().contains("NaN"),
+        "{err}"
+    );
+    assert_eq!(vector(&c, "fluid.pressure_gradient"), before);
+    let solid = c.variable("fluid.solid_fraction").unwrap();
+    let err = c
+        .set_real(
+            &[VarRef {
+                var: solid,
+                element: 3,
+            }],
+            &[0.5],
+        )
+        .unwrap_err();
+    assert!(err.to_string().contains("cannot be set"), "{err}");
+    let err = c
+        .set_real(
+            &[VarRef {
+                var: solid,
+                element: 54,
+            }],
+            &[0.5],
+        )
+        .unwrap_err();
+    assert!(err.to_string().contains("element 54"), "{err}");
+}
+
+#[test]
+fn a_restored_state_steps_to_the_same_fluid_outputs() {
+    let mut c = column();
+    c.enter_initialization_mode(0.0).unwrap();
+    c.exit_initialization_mode().unwrap();
+    let h = 7e-5 * 3.0;
+    set(&mut c, "fluid.velocity", &swirl(54, 0.3)).unwrap();
+    c.do_step(0.0, h).unwrap();
+    let saved = c.save_state().unwrap();
+    let bytes = c.state_to_bytes(&saved);
+    set(&mut c, "fluid.velocity", &swirl(54, 1.1)).unwrap();
+    c.do_step(h, h).unwrap();
+    let outputs = |c: &Component| {
+        [
+            "fluid.momentum_source",
+            "fluid.solid_fraction",
+            "fluid.particle_velocity",
+            "fluid.velocity",
+        ]
+        .map(|n| vector(c, n))
+    };
+    let first = outputs(&c);
+    let state = c.state_from_bytes(&bytes).unwrap();
+    c.restore_state(&state).unwrap();
+    assert_eq!(
+        vector(&c, "fluid.velocity"),
+        swirl(54, 0.3),
+        "the inputs go back too"
+    );
+    set(&mut c, "fluid.velocity", &swirl(54, 1.1)).unwrap();
+    c.do_step(h, h).unwrap();
+    assert_eq!(outputs(&c), first);
+}
