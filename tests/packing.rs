@@ -69,6 +69,56 @@ fn talus(dir: &Path, args: &[&str]) -> std::process::Output {
         .unwrap()
 }
 
+/// The STL of a capped bed: every edge shared by exactly two facets in opposite
+/// directions (closed, oriented shells), `shells` of them (connected by edges), and
+/// every two at least `gap` apart (GJK between their hulls; the STL's single
+/// precision allows 1e-3 of the gap).
+fn check_capped_stl(path: &Path, gap: f64, shells: usize) {
+    use std::collections::HashMap;
+    use talus::geometry::ConvexPolyhedron;
+    use talus::geometry::gjk::gjk;
+    let mesh = talus::geometry::mesh_io::read_stl(path).unwrap();
+    let mut edges: HashMap<(usize, usize), usize> = HashMap::new();
+    for t in &mesh.triangles {
+        for e in 0..3 {
+            *edges.entry((t[e], t[(e + 1) % 3])).or_default() += 1;
+        }
+    }
+    for (&(u, v), &count) in &edges {
+        assert_eq!(count, 1, "edge {u}-{v} in {count} facets the same way");
+        assert_eq!(edges.get(&(v, u)), Some(&1), "edge {u}-{v} open");
+    }
+    // Shells: components of the vertex graph.
+    let mut shell: Vec<usize> = (0..mesh.vertices.len()).collect();
+    fn root(shell: &mut [usize], mut v: usize) -> usize {
+        while shell[v] != v {
+            shell[v] = shell[shell[v]];
+            v = shell[v];
+        }
+        v
+    }
+    for &(u, v) in edges.keys() {
+        let (a, b) = (root(&mut shell, u), root(&mut shell, v));
+        shell[a] = b;
+    }
+    let mut points: HashMap<usize, Vec<nalgebra::Point3<f64>>> = HashMap::new();
+    for (v, x) in mesh.vertices.iter().enumerate() {
+        points.entry(root(&mut shell, v)).or_default().push(*x);
+    }
+    assert_eq!(points.len(), shells);
+    let hulls: Vec<ConvexPolyhedron> = points
+        .values()
+        .map(|p| ConvexPolyhedron::from_hull(p).unwrap())
+        .collect();
+    for (a, ha) in hulls.iter().enumerate() {
+        for hb in &hulls[a + 1..] {
+            let b_in_a = ha.body_to_input().inverse() * hb.body_to_input();
+            let d = gjk(ha, hb, &b_in_a, None).distance();
+            assert!(d > gap * 0.999, "two capped particles {d} apart");
+        }
+    }
+}
+
 fn json(path: &Path) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
 }
@@ -117,6 +167,27 @@ fn a_run_writes_the_packing_and_analyze_reproduces_it() {
         "60 icospheres of 320 triangles"
     );
     assert!(out.join("packing_radial.csv").exists() && out.join("packing_axial.csv").exists());
+    // The capped bed for a CFD mesher: 60 closed shells, every two at least the
+    // gap (d/100) apart, and the contacts they were capped at.
+    check_capped_stl(&out.join("bed_caps.stl"), 5e-5, 60);
+    let contacts = std::fs::read_to_string(out.join("contacts.csv")).unwrap();
+    let rows: Vec<Vec<f64>> = contacts
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+        .collect();
+    assert!(
+        rows.len() > 60,
+        "a settled bed has contacts: {}",
+        rows.len()
+    );
+    for r in &rows {
+        let n = (r[5] * r[5] + r[6] * r[6] + r[7] * r[7]).sqrt();
+        assert!(
+            (n - 1.0).abs() < 1e-8 && r[8] <= 5e-5 && r[0] < r[1],
+            "{r:?}"
+        );
+    }
     // Both profiles plotted: a title, the profile and the bed average in their
     // colours.
     for name in ["packing_radial.png", "packing_axial.png"] {
@@ -235,7 +306,8 @@ fn an_inlet_feeds_until_the_bed_height_is_reached() {
     let inserted = sim.inlets()[0].inserted;
     assert_eq!(sim.inlets()[0].count, inserted, "the inlet stopped");
     assert!((50..150).contains(&inserted), "{inserted} spheres");
-    let (height, porosity) = bed_figures(sim.world(), &bed).unwrap();
+    let figures = bed_figures(sim.world(), &bed).unwrap();
+    let (height, porosity) = (figures.height, figures.porosity);
     println!("{inserted} spheres, bed height {height:.4} m, porosity {porosity:.3}");
     assert!(
         height > target - 0.5 * d && height < target + 2.0 * d,
@@ -364,7 +436,8 @@ fn a_bed_fed_from_above_with_its_buried_part_frozen() {
     for freeze in [true, false] {
         let (sim, frozen_at, bed) = fill_from_above(freeze);
         let inlet = &sim.inlets()[0];
-        let (height, porosity) = bed_figures(sim.world(), &bed).unwrap();
+        let measured = bed_figures(sim.world(), &bed).unwrap();
+        let (height, porosity) = (measured.height, measured.porosity);
         let p = &sim.world().particles;
         let frozen = p.frozen_count();
         println!(
@@ -405,4 +478,58 @@ fn a_bed_fed_from_above_with_its_buried_part_frozen() {
     };
     assert!((h1 - h0).abs() < d, "heights {h1} and {h0}");
     assert!((e1 - e0).abs() < 0.02, "porosities {e1} and {e0}");
+}
+
+/// The reactor figures of a tube of pellets (20-gon prisms, D = L = 5.5 mm): the
+/// Sauter diameter and sphericity those of the prism's closed form, and the
+/// component's bed outputs the full analysis's numbers.
+#[test]
+fn the_reactor_figures_of_a_pellet_tube_reach_the_component() {
+    use std::f64::consts::PI;
+    use talus::analysis::packing::analyse;
+    use talus::cosim::Component;
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let text = std::fs::read_to_string(root.join("tests/scenes/tube_bed.toml")).unwrap()
+        + "\n[bed]\nbase = [0.0, 0.0, 0.0]\nradius = 0.0125\nexclude = 0.004\n";
+    let dir = std::env::temp_dir().join(format!("talus-reactor-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("tube.toml"), text).unwrap();
+    let mut c = Component::instantiate(&dir, "tube.toml").unwrap();
+    let _ = std::fs::remove_dir_all(&dir);
+    c.enter_initialization_mode(0.0).unwrap();
+    c.exit_initialization_mode().unwrap();
+    let read = |name: &str| c.get_real_vector(c.variable(name).unwrap()).unwrap()[0];
+    let bed = c.scene().bed.unwrap();
+    let packing = analyse(c.simulation().unwrap().world(), &bed).unwrap();
+    let r = &packing.reactor;
+    // A regular 20-gon prism of circumradius a and length L.
+    let (n, a, l) = (20.0, 0.00275, 0.0055);
+    let polygon = 0.5 * n * a * a * (2.0 * PI / n).sin();
+    let volume = polygon * l;
+    let surface = 2.0 * polygon + n * 2.0 * a * (PI / n).sin() * l;
+    let d_v = (6.0 * volume / PI).cbrt();
+    assert!((r.sauter_diameter / (6.0 * volume / surface) - 1.0).abs() < 1e-12);
+    assert!((r.volume_equivalent_diameter / d_v - 1.0).abs() < 1e-12);
+    assert!((r.sphericity - PI * d_v * d_v / surface).abs() < 1e-12);
+    assert!(
+        (r.specific_surface / ((1.0 - packing.porosity) * surface / volume) - 1.0).abs() < 1e-12
+    );
+    println!(
+        "lattice of pellets: porosity {:.4}, a_v {:.1} 1/m, wall contacts {:.3}, K {:.3e} m²",
+        packing.porosity, r.specific_surface, r.wall_contact_fraction, r.permeability_kozeny_carman
+    );
+    // The component's quick figures integrate the one full disc, the analysis all
+    // the radial bins at once: the same volumes to the quadrature's tolerance.
+    for (name, full) in [
+        ("porosity", packing.porosity),
+        ("specific_surface", r.specific_surface),
+        ("permeability", r.permeability_kozeny_carman),
+    ] {
+        assert!(
+            (read(name) / full - 1.0).abs() < 1e-9,
+            "{name}: {} against {full}",
+            read(name)
+        );
+    }
+    assert!(r.permeability_ergun > r.permeability_kozeny_carman);
 }

@@ -62,6 +62,19 @@ fn two_hundred_pellets_at_n_4_5_settle_into_a_wall_ordered_bed() {
         packing.coordination_mean
     );
     println!("eps(distance from the wall / d_p): {profile:.3?}");
+    let r = &packing.reactor;
+    println!(
+        "a_v {:.1} 1/m, d_S {:.3e} m, d_v {:.3e} m, sphericity {:.4}, wall contacts {:.3}, \
+         K (Kozeny-Carman) {:.3e} m², K (Ergun) {:.3e} m², beta (Ergun) {:.3e} 1/m",
+        r.specific_surface,
+        r.sauter_diameter,
+        r.volume_equivalent_diameter,
+        r.sphericity,
+        r.wall_contact_fraction,
+        r.permeability_kozeny_carman,
+        r.permeability_ergun,
+        r.inertial_coefficient_ergun
+    );
     // Bed-averaged porosity of random beds of equilateral cylinders at N ≈ 4.5 lies
     // about 0.40–0.45 (wall effect included); a 200-pellet bed scatters about it.
     assert!(

@@ -96,11 +96,14 @@ def main():
     np.savetxt(out / "pressure_drop.csv", rows, delimiter=",",
                header="superficial_velocity_m_s,pressure_drop_Pa,bed_height_m", comments="")
     n_up = len(up)
-    # U_mf by the pressure-drop method: the rising fixed-bed branch meets the weight.
+    # U_mf by the pressure-drop method: the fixed-bed branch (the rising velocities
+    # up to the first drop above 90 % of the weight), fitted by Ergun's form
+    # a U + b U², meets the weight.
     rising = rows[:n_up]
-    k = int(np.argmax(rising[:, 1] >= weight)) if np.any(rising[:, 1] >= weight) else n_up - 1
-    fixed = rising[: max(k, 2)]
-    fit = np.polyfit(fixed[:, 0], fixed[:, 1], 2)
+    above = np.nonzero(rising[:, 1] >= 0.9 * weight)[0]
+    fixed = rising[: above[0] if len(above) else n_up]
+    a, b = np.linalg.lstsq(np.column_stack([fixed[:, 0], fixed[:, 0] ** 2]), fixed[:, 1], rcond=None)[0]
+    fit = np.array([b, a, 0.0])
     roots = [r.real for r in np.roots(fit - np.array([0, 0, weight])) if abs(r.imag) < 1e-9 and r.real > 0]
     u_mf = min(roots) if roots else float("nan")
     print(f"U_mf from the pressure drop: {u_mf:.3f} m/s; Wen-Yu {u_wy:.3f} m/s "

@@ -138,9 +138,17 @@ impl Component {
                 (Some(s), Some(d)) => d.surface(s.world()).map_or(0.0, |f| f.slope.atan().abs()),
                 _ => 0.0,
             },
-            Role::BedHeight | Role::BedPorosity => match (sim, &self.scene.bed) {
+            Role::BedHeight
+            | Role::BedPorosity
+            | Role::BedSpecificSurface
+            | Role::BedPermeability => match (sim, &self.scene.bed) {
                 (Some(s), Some(bed)) => crate::analysis::packing::bed_figures(s.world(), bed)
-                    .map_or(0.0, |(h, e)| if role == Role::BedHeight { h } else { e }),
+                    .map_or(0.0, |f| match role {
+                        Role::BedHeight => f.height,
+                        Role::BedPorosity => f.porosity,
+                        Role::BedSpecificSurface => f.specific_surface,
+                        _ => f.permeability,
+                    }),
                 _ => 0.0,
             },
             Role::FluidVelocity | Role::PressureGradient => {

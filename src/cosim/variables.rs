@@ -99,6 +99,10 @@ pub enum Role {
     BedHeight,
     /// Output: bed-averaged porosity at the end of the step.
     BedPorosity,
+    /// Output: the bed's specific surface area at the end of the step.
+    BedSpecificSurface,
+    /// Output: the bed's Kozeny–Carman permeability at the end of the step.
+    BedPermeability,
     /// Input per fluid cell: the fluid's (interstitial) velocity.
     FluidVelocity,
     /// Input per fluid cell: the pressure gradient.
@@ -345,6 +349,24 @@ pub fn variable_table(scene: &Scene) -> Vec<Variable> {
                      particle volumes, leaving out the layers at the base and the top \
                      (0 while the bed is too low to leave a region)",
                 ),
+            Variable::new(
+                "specific_surface".into(),
+                Role::BedSpecificSurface,
+                Output,
+                1,
+            )
+            .unit("1/m")
+            .about(
+                "Particle surface per bed volume over the porosity's region at the end \
+                     of the step (0 while the bed is too low to leave a region)",
+            ),
+            Variable::new("permeability".into(), Role::BedPermeability, Output, 1)
+                .unit("m2")
+                .about(
+                    "Kozeny-Carman permeability of the porosity's region at the end of the \
+                     step, from its porosity and Sauter diameter (0 while the bed is too \
+                     low to leave a region)",
+                ),
         ]);
     }
     if let Some(fluid) = &scene.world.fluid {
@@ -443,6 +465,8 @@ pub fn unit_exponents(unit: &str) -> [i32; 4] {
         "J" => [1, 2, -2, 0],
         "W" => [1, 2, -3, 0],
         "Pa/m" => [1, -2, -2, 0],
+        "1/m" => [0, -1, 0, 0],
+        "m2" => [0, 2, 0, 0],
         _ => [0, 0, 0, 0],
     }
 }

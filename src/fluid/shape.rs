@@ -61,11 +61,11 @@ impl DragShape {
                 })
                 .collect(),
         };
-        let surface: Real = face_areas.iter().map(|a| a.norm()).sum();
-        let sphericity = if face_areas.is_empty() {
-            1.0
-        } else {
-            std::f64::consts::PI * diameter * diameter / surface
+        let sphericity = match shape {
+            Shape::Sphere(_) => 1.0,
+            Shape::Polyhedron(_) => {
+                std::f64::consts::PI * diameter * diameter / shape.surface_area()
+            }
         };
         DragShape {
             diameter,

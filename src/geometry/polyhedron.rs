@@ -248,6 +248,20 @@ impl ConvexPolyhedron {
         self.volume
     }
 
+    /// Surface area: the sum of the faces' areas.
+    pub fn surface_area(&self) -> Real {
+        (0..self.face_count())
+            .map(|f| {
+                let face: Vec<Point3<Real>> = self
+                    .face(f)
+                    .iter()
+                    .map(|&k| self.vertices[k as usize])
+                    .collect();
+                super::vector_area(&face).norm()
+            })
+            .sum()
+    }
+
     /// Centroid in the body frame: the origin, by construction.
     pub fn centroid(&self) -> Point3<Real> {
         Point3::origin()

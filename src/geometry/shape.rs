@@ -49,6 +49,14 @@ impl Shape {
         }
     }
 
+    /// Surface area.
+    pub fn surface_area(&self) -> Real {
+        match self {
+            Shape::Sphere(s) => 4.0 * PI * s.radius * s.radius,
+            Shape::Polyhedron(p) => p.surface_area(),
+        }
+    }
+
     /// Principal moments of inertia per unit density.
     pub fn principal_inertia(&self) -> Vector3<Real> {
         match self {

@@ -2,15 +2,21 @@
 //!
 //! - `packing.json`: the figures of [`crate::analysis::packing::Packing`] (bed
 //!   height, region, bed-averaged porosity with the quadrature's error estimate,
-//!   coordination and orientation distributions, both profiles);
-//! - `packing_radial.csv` (`r_inner,r_outer,porosity`) and `packing_axial.csv`
+//!   coordination and orientation distributions, both profiles, and the reactor
+//!   figures: specific surface, diameters, wall contacts, permeabilities);
+//! - `packing_radial.csv` (`r_inner,r_outer,porosity,specific_surface`) and
+//!   `packing_axial.csv`
 //!   (`z_lower,z_upper,porosity`, heights above the tube's base), and their plots
 //!   `packing_radial.png` (against the distance from the wall in particle diameters)
 //!   and `packing_axial.png`;
 //! - `poses.csv`: `id,kind,shape,x,y,z,qw,qx,qy,qz` per particle (the body frame's
 //!   pose: centroid and principal axes), which `talus analyze` reads back;
 //! - `bed.stl`: every particle's surface in place (spheres as 320-triangle
-//!   icospheres), each scaled about its centroid by the scene's `shrink`.
+//!   icospheres), each scaled about its centroid by the scene's `shrink`;
+//! - `bed_caps.stl`: every particle capped where it touches a neighbour or the
+//!   tube, a gap apart from all ([`crate::analysis::packing::mesher`]), and
+//!   `contacts.csv` (`id_i,id_j,x,y,z,nx,ny,nz,gap`): the contacts closer than that
+//!   gap, normal from `i` to `j`, gap negative for an overlap.
 
 use std::fs::File;
 use std::io::{self, BufWriter, Write};
@@ -22,7 +28,8 @@ use crate::Real;
 use plotters::chart::SeriesLabelPosition;
 
 use super::plot::LineChart;
-use crate::analysis::packing::Packing;
+use crate::analysis::packing::mesher::{bed_contacts, capped_particles};
+use crate::analysis::packing::{Bed, Packing};
 use crate::geometry::Shape;
 use crate::geometry::generators::icosphere_mesh;
 use crate::geometry::mesh_io::write_stl;
@@ -36,16 +43,16 @@ pub fn write_packing(dir: &Path, packing: &Packing) -> io::Result<()> {
     let radial = packing
         .radial
         .iter()
-        .map(|b| [b.r_inner, b.r_outer, b.porosity]);
+        .map(|b| vec![b.r_inner, b.r_outer, b.porosity, b.specific_surface]);
     write_profile(
         &dir.join("packing_radial.csv"),
-        "r_inner,r_outer,porosity",
+        "r_inner,r_outer,porosity,specific_surface",
         radial,
     )?;
     let axial = packing
         .axial
         .iter()
-        .map(|s| [s.z_lower, s.z_upper, s.porosity]);
+        .map(|s| vec![s.z_lower, s.z_upper, s.porosity]);
     write_profile(
         &dir.join("packing_axial.csv"),
         "z_lower,z_upper,porosity",
@@ -108,16 +115,17 @@ fn plot_profiles(dir: &Path, packing: &Packing) -> io::Result<()> {
     chart.write_png(&dir.join("packing_axial.png"))
 }
 
-/// A profile as CSV: bin edges and porosity per row.
+/// A profile as CSV: bin edges and the bin's figures per row.
 fn write_profile(
     path: &Path,
     header: &str,
-    rows: impl Iterator<Item = [Real; 3]>,
+    rows: impl Iterator<Item = Vec<Real>>,
 ) -> io::Result<()> {
     let mut out = BufWriter::new(File::create(path)?);
     writeln!(out, "{header}")?;
-    for [a, b, e] in rows {
-        writeln!(out, "{a:.9e},{b:.9e},{e:.9e}")?;
+    for row in rows {
+        let cells: Vec<String> = row.iter().map(|x| format!("{x:.9e}")).collect();
+        writeln!(out, "{}", cells.join(","))?;
     }
     out.flush()
 }
@@ -217,6 +225,33 @@ pub fn parse_poses(text: &str, path: &Path, world: &mut World) -> Result<(), Str
             .push(kind, Point3::new(v[0], v[1], v[2]), q, id);
     }
     Ok(())
+}
+
+/// Writes `bed_caps.stl` and `contacts.csv` (see the module docs).
+pub fn write_capped_bed(dir: &Path, world: &World, bed: &Bed) -> io::Result<()> {
+    let gap = bed.cap_gap(world);
+    let contacts = bed_contacts(world, gap).map_err(io::Error::other)?;
+    let mut out = BufWriter::new(File::create(dir.join("contacts.csv"))?);
+    writeln!(out, "id_i,id_j,x,y,z,nx,ny,nz,gap")?;
+    let id = &world.particles.id;
+    for c in &contacts {
+        let (x, n) = (c.point, c.normal);
+        writeln!(
+            out,
+            "{},{},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e}",
+            id[c.i], id[c.j], x.x, x.y, x.z, n.x, n.y, n.z, c.gap
+        )?;
+    }
+    out.flush()?;
+    let capped = capped_particles(world, &bed.tube, gap).map_err(io::Error::other)?;
+    let mut vertices = Vec::new();
+    let mut triangles = Vec::new();
+    for c in capped {
+        let base = vertices.len();
+        vertices.extend(c.vertices);
+        triangles.extend(c.triangles.iter().map(|t| t.map(|v| v as usize + base)));
+    }
+    write_stl(&dir.join("bed_caps.stl"), &vertices, &triangles)
 }
 
 /// Writes `bed.stl`: every particle's surface in place, scaled by `shrink` about

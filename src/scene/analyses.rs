@@ -130,6 +130,9 @@ pub(super) fn resolve_bed(spec: &BedSpec) -> Result<Bed, FieldError> {
         positive(path.key("depth"), f.depth)?;
         positive(path.key("max_speed"), f.max_speed)?;
     }
+    if let Some(g) = spec.cap_gap {
+        positive(path.key("cap_gap"), g)?;
+    }
     if !(spec.shrink > 0.0 && spec.shrink <= 1.0) {
         return Err(FieldError::new(
             path.key("shrink"),
@@ -148,6 +151,7 @@ pub(super) fn resolve_bed(spec: &BedSpec) -> Result<Bed, FieldError> {
             exclude: spec.exclude,
             gap: spec.gap,
             region: None,
+            cap_gap: spec.cap_gap,
         },
     })
 }

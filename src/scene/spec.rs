@@ -112,6 +112,9 @@ pub struct BedSpec {
     /// separates touching particles for CFD meshing).
     #[serde(default = "one")]
     pub shrink: Real,
+    /// The gap `bed_caps.stl` leaves between capped particles and between them and
+    /// the tube (default d/100; see [`crate::analysis::packing::mesher`]).
+    pub cap_gap: Option<Real>,
     /// Freeze the buried part of the bed while it is fed (see [`FreezeSpec`]).
     pub freeze: Option<FreezeSpec>,
 }

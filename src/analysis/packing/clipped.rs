@@ -12,6 +12,7 @@ use crate::world::World;
 /// A particle placed in the bed frame.
 pub(super) enum Body<'a> {
     Polyhedron {
+        centroid: Point3<Real>,
         vertices: Vec<Point3<Real>>,
         edges: &'a [[u32; 2]],
         volume: Real,
@@ -28,6 +29,7 @@ impl Body<'_> {
         let pose = frame * Isometry3::from_parts(p.position[i].coords.into(), p.orientation[i]);
         match &world.body_types[p.body_type[i] as usize].shape {
             Shape::Polyhedron(poly) => Body::Polyhedron {
+                centroid: pose * Point3::origin(),
                 vertices: poly.vertices().iter().map(|v| pose * v).collect(),
                 edges: poly.edges(),
                 volume: poly.volume(),
@@ -50,7 +52,25 @@ impl Body<'_> {
         }
     }
 
-    fn volume(&self) -> Real {
+    /// The centroid.
+    pub(super) fn centroid(&self) -> Point3<Real> {
+        match self {
+            Body::Polyhedron { centroid, .. } => *centroid,
+            Body::Sphere { centre, .. } => *centre,
+        }
+    }
+
+    /// The largest distance of a point of the body from the axis.
+    pub(super) fn reach(&self) -> Real {
+        match self {
+            Body::Polyhedron { vertices, .. } => {
+                vertices.iter().map(|v| v.x.hypot(v.y)).fold(0.0, Real::max)
+            }
+            Body::Sphere { centre, radius } => centre.x.hypot(centre.y) + radius,
+        }
+    }
+
+    pub(super) fn volume(&self) -> Real {
         match self {
             Body::Polyhedron { volume, .. } => *volume,
             Body::Sphere { radius, .. } => 4.0 / 3.0 * std::f64::consts::PI * radius.powi(3),

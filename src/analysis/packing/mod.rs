@@ -1,5 +1,8 @@
 //! The structure of a packed bed in a tube: bed height, bed-averaged porosity,
-//! radial and axial porosity profiles, coordination numbers and pellet orientations.
+//! radial and axial porosity profiles, coordination numbers, pellet orientations,
+//! and the figures reactor models take ([`ReactorFigures`]: specific surface and
+//! its radial profile, Sauter and volume-equivalent diameters, wall contacts,
+//! permeabilities).
 //!
 //! **Volumes.** Every figure of porosity comes from the volumes of the particles
 //! clipped to a region: a slab `z₀ ≤ z ≤ z₁` of the tube (z along its axis, from its
@@ -30,6 +33,8 @@
 
 mod clipped;
 mod coordination;
+pub mod mesher;
+mod reactor;
 
 use nalgebra::{Isometry3, Point3, UnitQuaternion, Vector3};
 use serde::Serialize;
@@ -39,6 +44,8 @@ use crate::geometry::Shape;
 use crate::world::World;
 use clipped::Body;
 use coordination::coordination;
+pub use reactor::ReactorFigures;
+use reactor::SolidShare;
 
 /// A tube: a point on its axis at the bed's base, the axis and the inner radius.
 #[derive(Clone, Copy, Debug)]
@@ -94,6 +101,18 @@ pub struct PackingOptions {
     pub gap: Option<Real>,
     /// Region to analyse instead of the one derived from the bed height.
     pub region: Option<(Real, Real)>,
+    /// Gap between capped particles (default d/100; see [`mesher`]).
+    pub cap_gap: Option<Real>,
+}
+
+impl Bed {
+    /// The gap of the capped bed: the option, or a hundredth of the largest
+    /// volume-equivalent diameter.
+    pub fn cap_gap(&self, world: &World) -> Real {
+        self.options
+            .cap_gap
+            .unwrap_or_else(|| largest_diameter(world) / 100.0)
+    }
 }
 
 /// One radial bin.
@@ -105,6 +124,8 @@ pub struct RadialBin {
     pub r_outer: Real,
     /// Porosity.
     pub porosity: Real,
+    /// Particle surface per annulus volume, 1/m (see [`ReactorFigures`]).
+    pub specific_surface: Real,
 }
 
 /// One axial slice.
@@ -152,6 +173,8 @@ pub struct Packing {
     pub orientation_cos: Vec<usize>,
     /// Order parameter ⟨(3 cos²θ − 1)/2⟩ (0 isotropic, 1 along the axis, −½ across).
     pub orientation_order: Option<Real>,
+    /// What reactor models need besides the porosity, over the region.
+    pub reactor: ReactorFigures,
 }
 
 /// A bed to analyse: the tube and the settings.
@@ -166,6 +189,8 @@ pub struct Bed {
 /// Bodies placed in the bed frame with the derived lengths.
 struct Placed<'a> {
     bodies: Vec<Body<'a>>,
+    /// Each body's surface over its volume.
+    surface_ratio: Vec<Real>,
     tube: Tube,
     diameter: Real,
     bin: Real,
@@ -196,10 +221,16 @@ impl<'a> Placed<'a> {
             }
         }
         let frame = tube.frame();
+        let kept: Vec<usize> = (0..world.particles.len()).filter(|&i| keep(i)).collect();
+        let shape = |i: usize| &world.body_types[world.particles.body_type[i] as usize].shape;
         Ok(Placed {
-            bodies: (0..world.particles.len())
-                .filter(|&i| keep(i))
-                .map(|i| Body::place(world, i, &frame))
+            bodies: kept
+                .iter()
+                .map(|&i| Body::place(world, i, &frame))
+                .collect(),
+            surface_ratio: kept
+                .iter()
+                .map(|&i| shape(i).surface_area() / shape(i).volume())
                 .collect(),
             tube,
             diameter,
@@ -269,30 +300,74 @@ impl<'a> Placed<'a> {
         }
     }
 
-    /// Solid volume inside each disc of `radii` between `z0` and `z1`, and the
-    /// estimated quadrature error.
-    fn volumes(&self, z0: Real, z1: Real, radii: &[Real]) -> (Vec<Real>, Real) {
-        let mut inside = vec![0.0; radii.len()];
+    /// The solid's share inside each disc of `radii` between `z0` and `z1`, and the
+    /// estimated quadrature error of its volume.
+    fn volumes(&self, z0: Real, z1: Real, radii: &[Real]) -> (Vec<SolidShare>, Real) {
+        let mut inside = vec![SolidShare::default(); radii.len()];
         let mut error = 0.0;
-        for b in &self.bodies {
+        for (b, ratio) in self.bodies.iter().zip(&self.surface_ratio) {
             let (v, e) = b.clipped_volumes(z0, z1, radii);
             error += e;
+            let whole = b.volume();
             for (acc, x) in inside.iter_mut().zip(v) {
-                *acc += x;
+                acc.volume += x;
+                acc.surface += x * ratio;
+                acc.count += x / whole;
             }
         }
         (inside, error)
     }
+
+    /// Of the bodies with their centroid between `z0` and `z1`, the share reaching
+    /// within `gap` of the tube wall.
+    fn wall_contact_fraction(&self, z0: Real, z1: Real, gap: Real) -> Real {
+        let inside = self
+            .bodies
+            .iter()
+            .filter(|b| (z0..=z1).contains(&b.centroid().z));
+        let (mut all, mut touching) = (0usize, 0usize);
+        for b in inside {
+            all += 1;
+            touching += usize::from(b.reach() >= self.tube.radius - gap);
+        }
+        if all == 0 {
+            0.0
+        } else {
+            touching as Real / all as Real
+        }
+    }
 }
 
-/// Bed height and bed-averaged porosity only (no profiles, coordination or
-/// orientations): cheap enough to follow a bed while it is being tapped.
-pub fn bed_figures(world: &World, bed: &Bed) -> Result<(Real, Real), String> {
+/// The figures [`bed_figures`] gives.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BedFigures {
+    /// Bed height, m above the base.
+    pub height: Real,
+    /// Bed-averaged porosity over the region.
+    pub porosity: Real,
+    /// Specific surface area over the region, 1/m ([`ReactorFigures`]).
+    pub specific_surface: Real,
+    /// Kozeny–Carman permeability over the region, m² ([`ReactorFigures`]).
+    pub permeability: Real,
+}
+
+/// Bed height, bed-averaged porosity, specific surface and permeability only (no
+/// profiles, coordination or orientations): cheap enough to follow a bed while it
+/// is being tapped.
+pub fn bed_figures(world: &World, bed: &Bed) -> Result<BedFigures, String> {
     let placed = Placed::new(world, bed, |_| true)?;
     let (_, height) = placed.axial();
     let (z0, z1) = placed.region(height, bed.options.region)?;
     let (v, _) = placed.volumes(z0, z1, &[placed.tube.radius]);
-    Ok((height, 1.0 - v[0] / (placed.area() * (z1 - z0))))
+    let bed_volume = placed.area() * (z1 - z0);
+    let porosity = 1.0 - v[0].volume / bed_volume;
+    let reactor = ReactorFigures::new(bed_volume, porosity, v[0], 0.0);
+    Ok(BedFigures {
+        height,
+        porosity,
+        specific_surface: reactor.specific_surface,
+        permeability: reactor.permeability_kozeny_carman,
+    })
 }
 
 /// Bed height of the particles that `member` marks: while a bed is fed, those
@@ -335,20 +410,30 @@ pub fn analyse(world: &World, bed: &Bed) -> Result<Packing, String> {
     let (inside, volume_error) = placed.volumes(z0, z1, &radii);
     let height = z1 - z0;
     let mut radial = Vec::with_capacity(bins);
-    let mut previous = (0.0, 0.0);
+    let mut previous = (0.0, SolidShare::default());
     for (k, &r) in radii.iter().enumerate() {
         let annulus = std::f64::consts::PI * (r * r - previous.0 * previous.0) * height;
         radial.push(RadialBin {
             r_inner: previous.0,
             r_outer: r,
-            porosity: 1.0 - (inside[k] - previous.1) / annulus,
+            porosity: 1.0 - (inside[k].volume - previous.1.volume) / annulus,
+            specific_surface: (inside[k].surface - previous.1.surface) / annulus,
         });
         previous = (r, inside[k]);
     }
-    let solid_volume = inside.last().copied().unwrap_or(0.0);
+    let solid = inside.last().copied().unwrap_or_default();
+    let solid_volume = solid.volume;
     let d = placed.diameter;
-    let (coordination_mean, coordination) =
-        coordination(world, bed.options.gap.unwrap_or(d / 1000.0));
+    let gap = bed.options.gap.unwrap_or(d / 1000.0);
+    let (coordination_mean, coordination) = coordination(world, gap);
+    let bed_volume = placed.area() * height;
+    let porosity = 1.0 - solid_volume / bed_volume;
+    let reactor = ReactorFigures::new(
+        bed_volume,
+        porosity,
+        solid,
+        placed.wall_contact_fraction(z0, z1, gap),
+    );
     let (orientation_cos, orientation_order) = orientations(world, &placed.tube.axis);
     let slice = placed.slice;
     Ok(Packing {
@@ -358,7 +443,7 @@ pub fn analyse(world: &World, bed: &Bed) -> Result<Packing, String> {
         tube_to_particle: 2.0 * radius / d,
         bed_height,
         region: [z0, z1],
-        porosity: 1.0 - solid_volume / (placed.area() * height),
+        porosity,
         volume_error,
         solid_volume,
         radial,
@@ -375,6 +460,7 @@ pub fn analyse(world: &World, bed: &Bed) -> Result<Packing, String> {
         coordination,
         orientation_cos,
         orientation_order,
+        reactor,
     })
 }
 

@@ -1,7 +1,7 @@
 use super::*;
 use crate::contact::Material;
-use crate::geometry::Sphere;
 use crate::geometry::generators::cuboid;
+use crate::geometry::{ConvexPolyhedron, Sphere};
 use crate::world::BodyType;
 use std::f64::consts::PI;
 use std::sync::Arc;
@@ -88,6 +88,47 @@ fn a_column_of_spheres_has_its_closed_form_profile() {
     // section falls below half the column's median section, 0.2 below its pole
     // in slices of d/10 = 0.2.
     assert!((p.bed_height - 9.8).abs() < 1e-9, "{}", p.bed_height);
+    // Reactor figures: three whole spheres of surface 4π in a tube section 2.25π, 6
+    // high; a sphere's surface per volume is 3/a, so each annulus has 3 (1 − ε).
+    let r = &p.reactor;
+    assert!((r.specific_surface - 12.0 * PI / (2.25 * PI * 6.0)).abs() < 1e-12);
+    assert!((r.sauter_diameter - 2.0).abs() < 1e-12);
+    assert!((r.volume_equivalent_diameter - 2.0).abs() < 1e-12);
+    assert!((r.sphericity - 1.0).abs() < 1e-12);
+    for b in &p.radial {
+        assert!((b.specific_surface - 3.0 / a * (1.0 - b.porosity)).abs() < 1e-8);
+    }
+    assert_eq!(r.wall_contact_fraction, 0.0, "nothing reaches the wall");
+    let e = p.porosity;
+    let k = e.powi(3) * 4.0 / (1.0 - e).powi(2);
+    assert!((r.permeability_kozeny_carman / (k / 180.0) - 1.0).abs() < 1e-12);
+    assert!((r.permeability_ergun / (k / 150.0) - 1.0).abs() < 1e-12);
+    assert!((r.inertial_coefficient_ergun - 1.75 * (1.0 - e) / (e.powi(3) * 2.0)).abs() < 1e-12);
+}
+
+#[test]
+fn a_ring_of_spheres_at_the_wall_counts_its_wall_contacts() {
+    // Four spheres of radius 0.5 touching the wall of a tube of radius 1.5 (one
+    // pressed 1e-4 into it, one 1e-4 short of it, within the gap of d/1000), one
+    // 0.01 short (outside the gap), and one on the axis.
+    let (a, t) = (0.5, tube(1.5));
+    let offsets = [1.0, 1.0001, 0.9999, 1.0, 0.99, 0.0];
+    let ring: Vec<_> = offsets
+        .iter()
+        .enumerate()
+        .map(|(k, &rho)| {
+            let phi = k as Real;
+            let x = Point3::new(0.3 + rho * phi.cos(), -0.2 + rho * phi.sin(), 1.0);
+            (x, UnitQuaternion::identity())
+        })
+        .collect();
+    let world = world_of(Shape::Sphere(Sphere::new(a).unwrap()), &ring);
+    let options = PackingOptions {
+        region: Some((0.4, 1.6)),
+        ..Default::default()
+    };
+    let p = analyse(&world, &Bed { tube: t, options }).unwrap();
+    assert!((p.reactor.wall_contact_fraction - 4.0 / 6.0).abs() < 1e-15);
 }
 
 #[test]
@@ -147,6 +188,14 @@ fn a_column_of_turned_cubes_has_its_closed_form_profile() {
     assert_eq!(p.orientation_cos[9], 4);
     assert!((p.orientation_order.unwrap() - 1.0).abs() < 1e-12);
     assert!((p.bed_height - 4.0).abs() < 1e-9);
+    // 3.35 cubes' worth of surface (6 each) in the region: the Sauter diameter is the
+    // edge, the sphericity the cube's (π^⅓ 6^⅔ / 6).
+    let r = &p.reactor;
+    assert!((r.specific_surface - 6.0 / (PI * 0.81)).abs() < 1e-9);
+    assert!((r.sauter_diameter - 1.0).abs() < 1e-9);
+    assert!((r.volume_equivalent_diameter - (6.0 / PI).cbrt()).abs() < 1e-9);
+    let cube_sphericity = PI.cbrt() * 36f64.cbrt() / 6.0;
+    assert!((r.sphericity - cube_sphericity).abs() < 1e-9);
     // The axial profile: one cube's cross-section in every slice below 4.
     for slice in &p.axial {
         assert!((slice.porosity - (1.0 - 1.0 / (PI * 0.81))).abs() < 1e-12);
@@ -251,4 +300,106 @@ fn a_random_bed_profile_integrates_to_its_average() {
         "{sampled} {}",
         p.porosity
     );
+}
+
+#[test]
+fn the_contacts_of_cubes_apart_and_overlapping() {
+    use super::mesher::bed_contacts;
+    let cube = Arc::new(cuboid(1.0, 1.0, 1.0).unwrap());
+    let at = |x: Real, y: Real| (Point3::new(x, y, 0.0), UnitQuaternion::identity());
+    // A; B 0.01 beyond A's +x face; C 0.02 into A's +y face (and 0.01 from B's
+    // −x face); D far off.
+    let world = world_of(
+        Shape::Polyhedron(cube),
+        &[at(0.0, 0.0), at(1.01, 0.0), at(0.0, 0.98), at(5.0, 5.0)],
+    );
+    let contacts = bed_contacts(&world, 0.05).unwrap();
+    let pairs: Vec<(usize, usize)> = contacts.iter().map(|c| (c.i, c.j)).collect();
+    assert_eq!(pairs, [(0, 1), (0, 2), (1, 2)]);
+    let (ab, ac, bc) = (contacts[0], contacts[1], contacts[2]);
+    assert!((ab.gap - 0.01).abs() < 1e-12 && (ab.normal - Vector3::x()).norm() < 1e-12);
+    assert!((ab.point.x - 0.505).abs() < 1e-12);
+    assert!((ac.gap + 0.02).abs() < 1e-12, "{}", ac.gap);
+    assert!((ac.normal - Vector3::y()).norm() < 1e-12);
+    assert!((ac.point - Point3::new(0.0, 0.49, 0.0)).norm() < 1e-12);
+    assert!((bc.gap - 0.01).abs() < 1e-12 && (bc.normal + Vector3::x()).norm() < 1e-12);
+    assert!(
+        bed_contacts(&world, 0.005).unwrap().len() == 1,
+        "only the overlap"
+    );
+}
+
+/// Spheres pressed into each other, the floor and the tube wall: every capped
+/// particle is a closed shell, every two at least the gap apart, all inside the
+/// tube's caps, and little of each is cut off.
+#[test]
+fn capped_spheres_are_closed_and_a_gap_apart() {
+    use super::mesher::capped_particles;
+    use crate::geometry::gjk::gjk;
+    let (t, gap) = (tube(1.5), 0.01);
+    let at = |rho: Real, phi: Real, z: Real| {
+        let x = Point3::new(0.3 + rho * phi.cos(), -0.2 + rho * phi.sin(), z);
+        (x, UnitQuaternion::identity())
+    };
+    let placements = [
+        at(0.0, 0.0, 0.49),  // into the floor
+        at(0.0, 0.0, 1.45),  // into the one below
+        at(0.98, 0.0, 0.5),  // into the first, near the wall
+        at(1.01, 2.0, 1.45), // into the wall
+        at(0.99, 2.0, 0.5),  // into the wall, beside the one above
+        at(0.0, 0.0, 3.0),   // alone
+    ];
+    let world = world_of(Shape::Sphere(Sphere::new(0.5).unwrap()), &placements);
+    let capped = capped_particles(&world, &t, gap).unwrap();
+    assert_eq!(capped.len(), 6);
+    let ball = crate::geometry::generators::icosphere_mesh(2, 0.5).unwrap();
+    let ball = ConvexPolyhedron::from_convex_mesh(&ball).unwrap().volume();
+    let mut hulls = Vec::new();
+    for (k, c) in capped.iter().enumerate() {
+        // Closed and consistently oriented: each directed edge once, and its twin.
+        let mut edges = std::collections::HashMap::new();
+        for t in &c.triangles {
+            for e in 0..3 {
+                *edges.entry((t[e], t[(e + 1) % 3])).or_insert(0) += 1;
+            }
+        }
+        for (&(u, v), &count) in &edges {
+            assert_eq!(count, 1, "particle {k}: edge {u}-{v} twice");
+            assert_eq!(
+                edges.get(&(v, u)),
+                Some(&1),
+                "particle {k}: edge {u}-{v} open"
+            );
+        }
+        for x in &c.vertices {
+            let r = x - t.base;
+            assert!(
+                r.z >= 0.5 * gap - 1e-12,
+                "particle {k} below the floor's cap"
+            );
+            let beyond = r.xy().norm() - (1.5 - 0.5 * gap);
+            assert!(
+                beyond <= 1e-12,
+                "particle {k} in the wall's cap by {beyond}"
+            );
+        }
+        let hull = ConvexPolyhedron::from_hull(&c.vertices).unwrap();
+        assert!(
+            hull.volume() > 0.9 * ball,
+            "particle {k}: {}",
+            hull.volume() / ball
+        );
+        hulls.push((hull.body_to_input().to_owned(), hull));
+    }
+    assert!(
+        (hulls[5].1.volume() / ball - 1.0).abs() < 1e-12,
+        "the lone one is whole"
+    );
+    for a in 0..6 {
+        for b in a + 1..6 {
+            let b_in_a = hulls[a].0.inverse() * hulls[b].0;
+            let d = gjk(&hulls[a].1, &hulls[b].1, &b_in_a, None).distance();
+            assert!(d >= gap * (1.0 - 1e-9), "particles {a} and {b}: {d}");
+        }
+    }
 }

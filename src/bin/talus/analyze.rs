@@ -5,7 +5,9 @@ use std::path::Path;
 
 use anyhow::{Context, Result, anyhow, bail};
 use talus::analysis::packing::{Bed, analyse};
-use talus::output::packing::{read_poses, write_bed_stl, write_packing, write_poses};
+use talus::output::packing::{
+    read_poses, write_bed_stl, write_capped_bed, write_packing, write_poses,
+};
 use talus::scene::Scene;
 use talus::world::World;
 
@@ -15,6 +17,7 @@ pub fn write_bed_files(scene: &Scene, bed: &Bed, world: &World, dir: &Path) -> R
     write_poses(dir, world, &scene.shape_names)?;
     let shrink = scene.spec.bed.as_ref().map_or(1.0, |b| b.shrink);
     write_bed_stl(dir, world, shrink)?;
+    write_capped_bed(dir, world, bed)?;
     let packing = analyse(world, bed).map_err(|e| anyhow!("packing analysis: {e}"))?;
     write_packing(dir, &packing)?;
     println!(

@@ -1,0 +1,284 @@
+//! The bed as a CFD mesher takes it: the list of contacts between the particles as
+//! they are meshed, and the particles "capped": flattened where they touch a
+//! neighbour or the tube, so that every pair is at least a gap apart and a volume
+//! mesher (snappyHexMesh, Fluent, STAR-CCM+) never meets a point contact.
+//!
+//! **Geometry.** Every particle is taken as the convex polyhedron `bed.stl` shows
+//! (a sphere as the 320-facet icosphere inscribed in it), so the contacts and caps
+//! are those of the surface the mesher receives. A pair's contact is the closest
+//! pair of points (GJK) when apart, the overlap's centroid and normal when they
+//! overlap, its gap the distance or minus the overlap's depth along the normal.
+//!
+//! **Caps.** For a contact of `A` and `B` closer than `gap`, at point `p` with normal
+//! `n` (from `A` to `B`), `A` keeps the half-space `n · (x − p) ≤ −gap/2` and `B`
+//! the half-space `n · (x − p) ≥ gap/2`: the two are then separated by the slab of
+//! width `gap` between the planes. Against the tube each particle keeps the
+//! half-space `a · (x − base) ≥ gap/2` above the base and the inside of the regular
+//! polygon of [`WALL_SIDES`] sides inscribed in the circle `R − gap/2` about the
+//! axis (only the sides it reaches cut it).
+//! A capped particle is the convex hull of its kept vertices and the points where
+//! its edges cross the plane: closed, convex, and gap-separated from every other.
+
+use std::collections::HashMap;
+use std::sync::Arc;
+
+use nalgebra::{Isometry3, Point3, Vector3};
+
+use super::Tube;
+use crate::Real;
+use crate::geometry::generators::icosphere_mesh;
+use crate::geometry::gjk::{GjkResult, gjk};
+use crate::geometry::overlap::overlap;
+use crate::geometry::{ConvexPolyhedron, GeometryError, Shape};
+use crate::world::World;
+
+/// Icosphere level of a sphere in `bed.stl` and the caps (320 facets).
+pub const SPHERE_LEVEL: u32 = 2;
+
+/// Sides of the polygon inscribed in the tube wall's cap that caps the particles at
+/// the wall: it lies within `1 − cos(π/720)`, about 1e-5, of the radius inside the
+/// circle.
+pub const WALL_SIDES: usize = 720;
+
+/// A contact between two particles as they are meshed.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BedContact {
+    /// Index of the first particle.
+    pub i: usize,
+    /// Index of the second particle (`j > i`).
+    pub j: usize,
+    /// Contact point: midway between the closest points, or the overlap's centroid.
+    pub point: Point3<Real>,
+    /// Unit normal from `i` towards `j`.
+    pub normal: Vector3<Real>,
+    /// Surface distance; negative: the overlap's depth along the normal.
+    pub gap: Real,
+}
+
+/// Each body type's shape as a polyhedron: itself, or a sphere's icosphere.
+fn templates(world: &World) -> Result<Vec<Arc<ConvexPolyhedron>>, GeometryError> {
+    let mut balls: HashMap<u64, Arc<ConvexPolyhedron>> = HashMap::new();
+    world
+        .body_types
+        .iter()
+        .map(|t| match &t.shape {
+            Shape::Polyhedron(p) => Ok(Arc::clone(p)),
+            Shape::Sphere(s) => match balls.get(&s.radius.to_bits()) {
+                Some(p) => Ok(Arc::clone(p)),
+                None => {
+                    let mesh = icosphere_mesh(SPHERE_LEVEL, s.radius)?;
+                    let p = Arc::new(ConvexPolyhedron::from_convex_mesh(&mesh)?);
+                    // The icosphere's centroid is the sphere's centre: its frame is
+                    // the body's up to a rotation, kept in `body_to_input`.
+                    balls.insert(s.radius.to_bits(), Arc::clone(&p));
+                    Ok(p)
+                }
+            },
+        })
+        .collect()
+}
+
+/// The pose of particle `i`'s template (its own body frame) in the world.
+fn placement(world: &World, templates: &[Arc<ConvexPolyhedron>], i: usize) -> Isometry3<Real> {
+    let p = &world.particles;
+    let body = Isometry3::from_parts(p.position[i].coords.into(), p.orientation[i]);
+    match world.body_types[p.body_type[i] as usize].shape {
+        Shape::Polyhedron(_) => body,
+        // The icosphere mesh was given in the body frame.
+        Shape::Sphere(_) => body * templates[p.body_type[i] as usize].body_to_input(),
+    }
+}
+
+/// The contacts of the particles closer than `within` (a cell grid on the centres
+/// finds the candidates), in order of `(i, j)`.
+pub fn bed_contacts(world: &World, within: Real) -> Result<Vec<BedContact>, GeometryError> {
+    let templates = templates(world)?;
+    let p = &world.particles;
+    let n = p.owned();
+    let reach = |i: usize| templates[p.body_type[i] as usize].circumradius();
+    let cell = 2.0 * (0..n).map(reach).fold(0.0, Real::max) + within;
+    let key = |x: &Point3<Real>| (x / cell).coords.map(|c| c.floor() as i64);
+    let mut grid: HashMap<_, Vec<usize>> = HashMap::new();
+    for i in 0..n {
+        grid.entry(key(&p.position[i])).or_default().push(i);
+    }
+    let mut contacts = Vec::new();
+    for i in 0..n {
+        let k = key(&p.position[i]);
+        let mut near = Vec::new();
+        for d in neighbour_offsets() {
+            if let Some(list) = grid.get(&(k + d)) {
+                near.extend(list.iter().copied().filter(|&j| j > i));
+            }
+        }
+        near.sort_unstable();
+        for j in near {
+            if (p.position[j] - p.position[i]).norm() > reach(i) + reach(j) + within {
+                continue;
+            }
+            let (a, b) = (
+                placement(world, &templates, i),
+                placement(world, &templates, j),
+            );
+            let (ta, tb) = (
+                &templates[p.body_type[i] as usize],
+                &templates[p.body_type[j] as usize],
+            );
+            let b_in_a = a.inverse() * b;
+            let contact = match gjk(&**ta, &**tb, &b_in_a, None) {
+                GjkResult::Separated {
+                    distance,
+                    point_a,
+                    point_b,
+                } => (distance <= within).then(|| BedContact {
+                    i,
+                    j,
+                    point: a * Point3::from((point_a.coords + point_b.coords) * 0.5),
+                    normal: a * ((point_b - point_a) / distance),
+                    gap: distance,
+                }),
+                GjkResult::Intersecting => overlap(ta, tb, &b_in_a).map(|o| BedContact {
+                    i,
+                    j,
+                    point: a * o.centroid,
+                    normal: a * o.normal,
+                    gap: -o.depth,
+                }),
+            };
+            contacts.extend(contact);
+        }
+    }
+    Ok(contacts)
+}
+
+/// The 27 neighbouring cells' offsets.
+fn neighbour_offsets() -> impl Iterator<Item = Vector3<i64>> {
+    (-1..=1).flat_map(|x| (-1..=1).flat_map(move |y| (-1..=1).map(move |z| Vector3::new(x, y, z))))
+}
+
+/// A half-space `normal · x ≤ offset` (world frame).
+#[derive(Clone, Copy, Debug)]
+struct Keep {
+    normal: Vector3<Real>,
+    offset: Real,
+}
+
+/// A capped particle: its vertices in the world and its triangles (counter-clockwise
+/// seen from outside).
+#[derive(Clone, Debug)]
+pub struct CappedParticle {
+    /// Vertices in the world.
+    pub vertices: Vec<Point3<Real>>,
+    /// Triangles.
+    pub triangles: Vec<[u32; 3]>,
+}
+
+/// Cuts `poly` (placed by `pose`) to the half-space; `None` if nothing is cut off.
+fn cut(
+    poly: &ConvexPolyhedron,
+    pose: &Isometry3<Real>,
+    keep: &Keep,
+) -> Result<Option<ConvexPolyhedron>, GeometryError> {
+    let world: Vec<Point3<Real>> = poly.vertices().iter().map(|v| pose * v).collect();
+    let side: Vec<Real> = world
+        .iter()
+        .map(|x| keep.normal.dot(&x.coords) - keep.offset)
+        .collect();
+    if side.iter().all(|&s| s <= 0.0) {
+        return Ok(None);
+    }
+    let mut points: Vec<Point3<Real>> = world
+        .iter()
+        .zip(&side)
+        .filter(|(_, s)| **s <= 0.0)
+        .map(|(x, _)| *x)
+        .collect();
+    for &[u, v] in poly.edges() {
+        let (su, sv) = (side[u as usize], side[v as usize]);
+        if (su > 0.0) != (sv > 0.0) {
+            let t = su / (su - sv);
+            points.push(world[u as usize] + (world[v as usize] - world[u as usize]) * t);
+        }
+    }
+    ConvexPolyhedron::from_hull(&points).map(Some)
+}
+
+/// Every particle capped against its contacts closer than `gap` and against the
+/// tube (see the module docs), in particle order.
+pub fn capped_particles(
+    world: &World,
+    tube: &Tube,
+    gap: Real,
+) -> Result<Vec<CappedParticle>, GeometryError> {
+    let templates = templates(world)?;
+    let p = &world.particles;
+    let axis = tube.axis.normalize();
+    let mut keeps: Vec<Vec<Keep>> = vec![Vec::new(); p.owned()];
+    for c in bed_contacts(world, gap)? {
+        let at = c.normal.dot(&c.point.coords);
+        keeps[c.i].push(Keep {
+            normal: c.normal,
+            offset: at - 0.5 * gap,
+        });
+        keeps[c.j].push(Keep {
+            normal: -c.normal,
+            offset: -(at + 0.5 * gap),
+        });
+    }
+    let floor = Keep {
+        normal: -axis,
+        offset: -(axis.dot(&tube.base.coords) + 0.5 * gap),
+    };
+    // The wall's cap: a polygon inscribed in the circle `R − gap/2`.
+    let apothem = (tube.radius - 0.5 * gap) * (std::f64::consts::PI / WALL_SIDES as Real).cos();
+    let e1 = axis
+        .cross(&Vector3::x())
+        .try_normalize(1e-6)
+        .unwrap_or_else(|| axis.cross(&Vector3::y()).normalize());
+    let e2 = axis.cross(&e1);
+    let wall_normals: Vec<Vector3<Real>> = (0..WALL_SIDES)
+        .map(|k| {
+            let angle = 2.0 * std::f64::consts::PI * k as Real / WALL_SIDES as Real;
+            e1 * angle.cos() + e2 * angle.sin()
+        })
+        .collect();
+    let radial = |x: &Point3<Real>| {
+        let r = x - tube.base;
+        r - axis * axis.dot(&r)
+    };
+    let mut capped = Vec::with_capacity(p.owned());
+    for (i, keeps) in keeps.iter().enumerate() {
+        let template = &templates[p.body_type[i] as usize];
+        let (mut poly, mut pose) = ((**template).clone(), placement(world, &templates, i));
+        for keep in keeps.iter().chain([&floor]) {
+            if let Some(next) = cut(&poly, &pose, keep)? {
+                pose = *next.body_to_input();
+                poly = next;
+            }
+        }
+        // Against the curved wall: the sides of the regular polygon of
+        // `WALL_SIDES` sides inscribed in the wall's cap that the particle reaches.
+        let reach = poly
+            .vertices()
+            .iter()
+            .map(|v| radial(&(pose * v)).norm())
+            .fold(0.0, Real::max);
+        if reach > apothem {
+            for normal in &wall_normals {
+                let keep = Keep {
+                    normal: *normal,
+                    offset: normal.dot(&tube.base.coords) + apothem,
+                };
+                if let Some(next) = cut(&poly, &pose, &keep)? {
+                    pose = *next.body_to_input();
+                    poly = next;
+                }
+            }
+        }
+        capped.push(CappedParticle {
+            vertices: poly.vertices().iter().map(|v| pose * v).collect(),
+            triangles: poly.triangles(),
+        });
+    }
+    Ok(capped)
+}
