@@ -512,8 +512,9 @@ cell = [0.01, 0.01, 0.01]
     )
 }
 
-/// The arrays of a `.vti` file written with raw appended data, by name.
-fn read_vti(path: &Path) -> Vec<(String, Vec<f32>)> {
+/// The arrays of a `.vti` or `.vtp` file written with raw appended data, by name, in
+/// the file's order (Float32 and Int64 arrays, as f64).
+fn read_vtk(path: &Path) -> Vec<(String, Vec<f64>)> {
     let bytes = std::fs::read(path).unwrap();
     let marker = b"<AppendedData encoding=\"raw\">\n   _";
     let start = bytes
@@ -522,21 +523,27 @@ fn read_vti(path: &Path) -> Vec<(String, Vec<f32>)> {
         .unwrap()
         + marker.len();
     let text = String::from_utf8_lossy(&bytes[..start]).to_string();
-    let names: Vec<String> = text
-        .split("Name=\"")
+    let field = |s: &str, key: &str| {
+        let s = &s[s.find(key).unwrap() + key.len()..];
+        s[..s.find('"').unwrap()].to_string()
+    };
+    text.split("<DataArray ")
         .skip(1)
-        .map(|s| s[..s.find('"').unwrap()].to_string())
-        .collect();
-    let mut at = start;
-    names
-        .into_iter()
-        .map(|name| {
+        .map(|a| {
+            let (ty, name) = (field(a, "type=\""), field(a, "Name=\""));
+            let at = start + field(a, "offset=\"").parse::<usize>().unwrap();
             let len = u64::from_le_bytes(bytes[at..at + 8].try_into().unwrap()) as usize;
-            let data = bytes[at + 8..at + 8 + len]
-                .chunks(4)
-                .map(|c| f32::from_le_bytes(c.try_into().unwrap()))
-                .collect();
-            at += 8 + len;
+            let raw = &bytes[at + 8..at + 8 + len];
+            let data = match ty.as_str() {
+                "Float32" => raw
+                    .chunks(4)
+                    .map(|c| f32::from_le_bytes(c.try_into().unwrap()) as f64)
+                    .collect(),
+                _ => raw
+                    .chunks(8)
+                    .map(|c| i64::from_le_bytes(c.try_into().unwrap()) as f64)
+                    .collect(),
+            };
             (name, data)
         })
         .collect()
@@ -570,12 +577,12 @@ fn talus_run_writes_the_fluid_grid_for_paraview() {
     for t in ["0.000000000e0", "1.000000000e-3", "2.000000000e-3"] {
         assert!(pvd.contains(&format!("timestep=\"{t}\"")), "{pvd}");
     }
-    let arrays = read_vti(&dir.join("out/frames/fluid_000002.vti"));
+    let arrays = read_vtk(&dir.join("out/frames/fluid_000002.vti"));
     let get = |n: &str| &arrays.iter().find(|a| a.0 == n).unwrap().1;
     assert_eq!(get("solid_fraction").len(), 54);
     assert_eq!(get("fluid_velocity").len(), 3 * 54);
     // The beads' volume, in single precision; the flow drags them upward.
-    let solid: f64 = get("solid_fraction").iter().map(|&x| x as f64).sum::<f64>() * 1e-6;
+    let solid: f64 = get("solid_fraction").iter().sum::<f64>() * 1e-6;
     let scene = Scene::load(&scene).unwrap();
     let beads =
         scene.world.particles.len() as f64 * 4.0 / 3.0 * std::f64::consts::PI * 0.002f64.powi(3);
@@ -583,8 +590,32 @@ fn talus_run_writes_the_fluid_grid_for_paraview() {
         (solid / beads - 1.0).abs() < 1e-5,
         "{solid} against {beads}"
     );
-    let lift: f64 = get("particle_drag").chunks(3).map(|v| v[2] as f64).sum();
+    let lift: f64 = get("particle_drag").chunks(3).map(|v| v[2]).sum();
     assert!(lift > 0.0, "{lift}");
+    // Each particle's drag, slip and voidage on its cells in the particle frame: the
+    // slip is the uniform flow less the particle's velocity (single precision), the
+    // drags sum to the grid's, the voidage lies within the packing's range.
+    let particles = read_vtk(&dir.join("out/frames/particles_000002.vtp"));
+    let get = |n: &str| &particles.iter().find(|a| a.0 == n).unwrap().1;
+    let (id, velocity, slip, drag, voidage) = (
+        get("id"),
+        get("velocity"),
+        get("slip"),
+        get("drag"),
+        get("voidage"),
+    );
+    let mut total = 0.0;
+    for c in 0..id.len() {
+        for k in 0..3 {
+            let flow = [0.0, 0.0, 0.05][k];
+            assert!((slip[3 * c + k] + velocity[3 * c + k] - flow).abs() < 1e-6);
+        }
+        assert!(voidage[c] > 0.2 && voidage[c] < 1.0, "{}", voidage[c]);
+        if c == 0 || id[c] != id[c - 1] {
+            total += drag[3 * c + 2];
+        }
+    }
+    assert!((total / lift - 1.0).abs() < 1e-5, "{total} against {lift}");
 }
 
 #[test]

@@ -3,7 +3,8 @@
 //!
 //! Particles are written as their actual surfaces: every merged face of a polyhedron
 //! is one polygon cell in its current pose (spheres as 80-facet icospheres), with the
-//! particle's id, kind, velocity, speed and angular velocity on each of its cells.
+//! particle's id, kind, velocity, speed and angular velocity on each of its cells
+//! (with a coupled fluid also its drag, slip velocity and local voidage).
 //! Walls are their facets in the current pose, with the wall index and the force on
 //! each facet. A coupled fluid's grid is ImageData (`.vti`) with its cell fields.
 
@@ -193,6 +194,8 @@ pub fn write_particles(world: &World, path: &Path) -> io::Result<()> {
     let mut pd = PolyData::default();
     let (mut id, mut kind, mut vel, mut speed, mut omega) =
         (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    // With a coupled fluid: each particle's drag, slip and local voidage.
+    let (mut drag, mut slip, mut voidage) = (Vec::new(), Vec::new(), Vec::new());
     let p = &world.particles;
     for i in 0..p.owned() {
         let t = &world.body_types[p.body_type[i] as usize];
@@ -226,6 +229,18 @@ pub fn write_particles(world: &World, path: &Path) -> io::Result<()> {
             speed.push(p.velocity[i].norm() as f32);
             omega.extend(w.iter().map(|&x| x as f32));
         }
+        if let Some(fluid) = &world.fluid {
+            let f = fluid.exchange.drag.get(i).copied().unwrap_or_default();
+            // Outside the grid: no fluid, no slip.
+            let (u, e) = fluid
+                .local(i, p.id[i], &p.position[i])
+                .map_or((p.velocity[i], 1.0), |l| (l.velocity, l.voidage));
+            for _ in 0..faces {
+                drag.extend(f.iter().map(|&x| x as f32));
+                slip.extend((u - p.velocity[i]).iter().map(|&x| x as f32));
+                voidage.push(e as f32);
+            }
+        }
     }
     pd.cell_data = vec![
         Array::I64 {
@@ -252,6 +267,25 @@ pub fn write_particles(world: &World, path: &Path) -> io::Result<()> {
             data: omega,
         },
     ];
+    if world.fluid.is_some() {
+        pd.cell_data.extend([
+            Array::F32 {
+                name: "drag".into(),
+                components: 3,
+                data: drag,
+            },
+            Array::F32 {
+                name: "slip".into(),
+                components: 3,
+                data: slip,
+            },
+            Array::F32 {
+                name: "voidage".into(),
+                components: 1,
+                data: voidage,
+            },
+        ]);
+    }
     pd.write(path)
 }
 

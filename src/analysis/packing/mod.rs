@@ -222,7 +222,12 @@ impl<'a> Placed<'a> {
         }
         let frame = tube.frame();
         let kept: Vec<usize> = (0..world.particles.len()).filter(|&i| keep(i)).collect();
-        let shape = |i: usize| &world.body_types[world.particles.body_type[i] as usize].shape;
+        // Per body type once: a polyhedron's surface sums its faces.
+        let ratio: Vec<Real> = world
+            .body_types
+            .iter()
+            .map(|t| t.shape.surface_area() / t.shape.volume())
+            .collect();
         Ok(Placed {
             bodies: kept
                 .iter()
@@ -230,7 +235,7 @@ impl<'a> Placed<'a> {
                 .collect(),
             surface_ratio: kept
                 .iter()
-                .map(|&i| shape(i).surface_area() / shape(i).volume())
+                .map(|&i| ratio[world.particles.body_type[i] as usize])
                 .collect(),
             tube,
             diameter,
