@@ -6,6 +6,8 @@ use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+mod common;
+
 /// The generator of the header (its `main` writes the file).
 #[allow(dead_code)]
 #[path = "../examples/c_header.rs"]
@@ -126,18 +128,7 @@ fn a_c_program_exchanges_the_fluid_fields_through_the_c_api() {
     let printed = run_c_program("fluid_test", scene);
     let mut c = talus::cosim::Component::instantiate(root(), scene).unwrap();
     let velocity = c.variable("fluid.velocity").unwrap();
-    let swirl = |phase: f64| -> Vec<f64> {
-        (0..54)
-            .flat_map(|c| {
-                let x = c as f64;
-                [
-                    0.3 * (x + phase).sin(),
-                    -0.2 * (0.5 * x).cos(),
-                    2.0 + 0.05 * x + phase,
-                ]
-            })
-            .collect()
-    };
+    let swirl = |phase: f64| common::fluid_swirl(54, phase);
     c.set_real_vector(velocity, &swirl(0.0)).unwrap();
     c.enter_initialization_mode(0.0).unwrap();
     c.exit_initialization_mode().unwrap();

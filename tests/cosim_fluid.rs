@@ -2,6 +2,8 @@
 //! the same numbers as the simulation driven directly, inputs set all or none, the
 //! momentum source the mean over each communication step, and saved states.
 
+mod common;
+
 use std::ops::ControlFlow;
 use std::path::Path;
 
@@ -30,18 +32,8 @@ fn set(c: &mut Component, name: &str, values: &[Real]) -> Result<(), CosimError>
     c.set_real_vector(var, values)
 }
 
-/// A fluid velocity differing from cell to cell, x y z per cell.
 fn swirl(cells: usize, phase: Real) -> Vec<Real> {
-    (0..cells)
-        .flat_map(|c| {
-            let c = c as Real;
-            [
-                0.3 * (c + phase).sin(),
-                -0.2 * (0.5 * c).cos(),
-                2.0 + 0.05 * c + phase,
-            ]
-        })
-        .collect()
+    common::fluid_swirl(cells, phase)
 }
 
 fn vec3s(flat: &[Real]) -> Vec<Vector3<Real>> {

@@ -11,15 +11,16 @@ use talus::transport::messages as pb;
 use talus::transport::{Node, NodeConfig, Service};
 use zenoh::Wait;
 
-fn drum() -> Component {
-    let mut c = Component::instantiate(
-        Path::new(env!("CARGO_MANIFEST_DIR")),
-        "examples/drum_fmu/drum.toml",
-    )
-    .unwrap();
+/// The component of `scene` (relative to the crate), initialised at time 0.
+fn started(scene: &str) -> Component {
+    let mut c = Component::instantiate(Path::new(env!("CARGO_MANIFEST_DIR")), scene).unwrap();
     c.enter_initialization_mode(0.0).unwrap();
     c.exit_initialization_mode().unwrap();
     c
+}
+
+fn drum() -> Component {
+    started("examples/drum_fmu/drum.toml")
 }
 
 fn query<R: Message + Default>(session: &zenoh::Session, key: &str, payload: Vec<u8>) -> R {
@@ -105,14 +106,7 @@ async fn a_client_steps_the_served_drum() {
 }
 
 fn fluid_column() -> Component {
-    let mut c = Component::instantiate(
-        Path::new(env!("CARGO_MANIFEST_DIR")),
-        "tests/scenes/fluid_column.toml",
-    )
-    .unwrap();
-    c.enter_initialization_mode(0.0).unwrap();
-    c.exit_initialization_mode().unwrap();
-    c
+    started("tests/scenes/fluid_column.toml")
 }
 
 /// The fluid over zenoh: a step carries the per-cell inputs, `<key>/fluid` answers

@@ -28,7 +28,7 @@ use crate::Real;
 use plotters::chart::SeriesLabelPosition;
 
 use super::plot::LineChart;
-use crate::analysis::packing::mesher::{bed_contacts, capped_particles};
+use crate::analysis::packing::mesher::{SPHERE_LEVEL, bed_contacts, capped_particles};
 use crate::analysis::packing::{Bed, Packing};
 use crate::geometry::Shape;
 use crate::geometry::generators::icosphere_mesh;
@@ -243,7 +243,7 @@ pub fn write_capped_bed(dir: &Path, world: &World, bed: &Bed) -> io::Result<()> 
         )?;
     }
     out.flush()?;
-    let capped = capped_particles(world, &bed.tube, gap).map_err(io::Error::other)?;
+    let capped = capped_particles(world, &bed.tube, gap, &contacts).map_err(io::Error::other)?;
     let mut vertices = Vec::new();
     let mut triangles = Vec::new();
     for c in capped {
@@ -274,7 +274,7 @@ pub fn write_bed_stl(dir: &Path, world: &World, shrink: Real) -> io::Result<()> 
             Shape::Sphere(s) => balls
                 .entry(s.radius.to_bits())
                 .or_insert_with(|| {
-                    let mesh = icosphere_mesh(2, s.radius).expect("a positive radius");
+                    let mesh = icosphere_mesh(SPHERE_LEVEL, s.radius).expect("a positive radius");
                     (mesh.vertices, mesh.triangles)
                 })
                 .clone(),

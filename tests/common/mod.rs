@@ -194,3 +194,19 @@ impl Picture {
         self.count([0, 0, 0], 90, rows)
     }
 }
+
+/// A fluid velocity differing from cell to cell, x y z per cell, for `cells` cells:
+/// the input of the fluid face tests (the C program `tests/c/fluid_test.c` computes
+/// the same).
+pub fn fluid_swirl(cells: usize, phase: f64) -> Vec<f64> {
+    (0..cells)
+        .flat_map(|c| {
+            let c = c as f64;
+            [
+                0.3 * (c + phase).sin(),
+                -0.2 * (0.5 * c).cos(),
+                2.0 + 0.05 * c + phase,
+            ]
+        })
+        .collect()
+}

@@ -7,48 +7,24 @@ use crate::geometry::Shape;
 use crate::geometry::gjk::{PointShape, gjk};
 use crate::world::World;
 
-/// Contacts per particle: surfaces within `gap` (a cell grid on the centres finds
-/// the candidates).
+use super::near::near_pairs;
+
+/// Contacts per particle: surfaces within `gap`.
 pub(super) fn coordination(world: &World, gap: Real) -> (Real, Vec<usize>) {
     let p = &world.particles;
     let n = p.len();
-    let reach = |i: usize| {
-        world.body_types[p.body_type[i] as usize]
-            .shape
-            .circumradius()
-    };
-    let cell = 2.0 * (0..n).map(reach).fold(0.0, Real::max) + gap;
-    let key = |x: &Point3<Real>| {
-        [
-            (x.x / cell).floor() as i64,
-            (x.y / cell).floor() as i64,
-            (x.z / cell).floor() as i64,
-        ]
-    };
-    let mut grid: std::collections::HashMap<[i64; 3], Vec<usize>> = Default::default();
-    for i in 0..n {
-        grid.entry(key(&p.position[i])).or_default().push(i);
-    }
+    let reach: Vec<Real> = (0..n)
+        .map(|i| {
+            world.body_types[p.body_type[i] as usize]
+                .shape
+                .circumradius()
+        })
+        .collect();
     let mut count = vec![0usize; n];
-    for i in 0..n {
-        let k = key(&p.position[i]);
-        for dx in -1..=1 {
-            for dy in -1..=1 {
-                for dz in -1..=1 {
-                    let Some(list) = grid.get(&[k[0] + dx, k[1] + dy, k[2] + dz]) else {
-                        continue;
-                    };
-                    for &j in list.iter().filter(|&&j| j > i) {
-                        if (p.position[j] - p.position[i]).norm() > reach(i) + reach(j) + gap {
-                            continue;
-                        }
-                        if surface_distance(world, i, j) <= gap {
-                            count[i] += 1;
-                            count[j] += 1;
-                        }
-                    }
-                }
-            }
+    for (i, j) in near_pairs(&p.position[..n], &reach, gap) {
+        if surface_distance(world, i, j) <= gap {
+            count[i] += 1;
+            count[j] += 1;
         }
     }
     let mean = count.iter().sum::<usize>() as Real / n.max(1) as Real;

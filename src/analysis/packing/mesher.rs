@@ -25,6 +25,7 @@ use std::sync::Arc;
 use nalgebra::{Isometry3, Point3, Vector3};
 
 use super::Tube;
+use super::near::near_pairs;
 use crate::Real;
 use crate::geometry::generators::icosphere_mesh;
 use crate::geometry::gjk::{GjkResult, gjk};
@@ -89,43 +90,27 @@ fn placement(world: &World, templates: &[Arc<ConvexPolyhedron>], i: usize) -> Is
     }
 }
 
-/// The contacts of the particles closer than `within` (a cell grid on the centres
-/// finds the candidates), in order of `(i, j)`.
+/// The contacts of the particles closer than `within`, in order of `(i, j)`.
 pub fn bed_contacts(world: &World, within: Real) -> Result<Vec<BedContact>, GeometryError> {
-    let templates = templates(world)?;
+    Ok(contacts(world, &templates(world)?, within))
+}
+
+/// [`bed_contacts`] of the particles as `templates` mesh them.
+fn contacts(world: &World, templates: &[Arc<ConvexPolyhedron>], within: Real) -> Vec<BedContact> {
     let p = &world.particles;
     let n = p.owned();
-    let reach = |i: usize| templates[p.body_type[i] as usize].circumradius();
-    let cell = 2.0 * (0..n).map(reach).fold(0.0, Real::max) + within;
-    let key = |x: &Point3<Real>| (x / cell).coords.map(|c| c.floor() as i64);
-    let mut grid: HashMap<_, Vec<usize>> = HashMap::new();
-    for i in 0..n {
-        grid.entry(key(&p.position[i])).or_default().push(i);
-    }
-    let mut contacts = Vec::new();
-    for i in 0..n {
-        let k = key(&p.position[i]);
-        let mut near = Vec::new();
-        for d in neighbour_offsets() {
-            if let Some(list) = grid.get(&(k + d)) {
-                near.extend(list.iter().copied().filter(|&j| j > i));
-            }
-        }
-        near.sort_unstable();
-        for j in near {
-            if (p.position[j] - p.position[i]).norm() > reach(i) + reach(j) + within {
-                continue;
-            }
+    let template = |i: usize| &templates[p.body_type[i] as usize];
+    let reach: Vec<Real> = (0..n).map(|i| template(i).circumradius()).collect();
+    near_pairs(&p.position[..n], &reach, within)
+        .into_iter()
+        .filter_map(|(i, j)| {
             let (a, b) = (
-                placement(world, &templates, i),
-                placement(world, &templates, j),
+                placement(world, templates, i),
+                placement(world, templates, j),
             );
-            let (ta, tb) = (
-                &templates[p.body_type[i] as usize],
-                &templates[p.body_type[j] as usize],
-            );
+            let (ta, tb) = (template(i), template(j));
             let b_in_a = a.inverse() * b;
-            let contact = match gjk(&**ta, &**tb, &b_in_a, None) {
+            match gjk(&**ta, &**tb, &b_in_a, None) {
                 GjkResult::Separated {
                     distance,
                     point_a,
@@ -144,16 +129,9 @@ pub fn bed_contacts(world: &World, within: Real) -> Result<Vec<BedContact>, Geom
                     normal: a * o.normal,
                     gap: -o.depth,
                 }),
-            };
-            contacts.extend(contact);
-        }
-    }
-    Ok(contacts)
-}
-
-/// The 27 neighbouring cells' offsets.
-fn neighbour_offsets() -> impl Iterator<Item = Vector3<i64>> {
-    (-1..=1).flat_map(|x| (-1..=1).flat_map(move |y| (-1..=1).map(move |z| Vector3::new(x, y, z))))
+            }
+        })
+        .collect()
 }
 
 /// A half-space `normal · x ≤ offset` (world frame).
@@ -203,18 +181,19 @@ fn cut(
     ConvexPolyhedron::from_hull(&points).map(Some)
 }
 
-/// Every particle capped against its contacts closer than `gap` and against the
-/// tube (see the module docs), in particle order.
+/// Every particle capped against `contacts` (the [`bed_contacts`] closer than
+/// `gap`) and against the tube (see the module docs), in particle order.
 pub fn capped_particles(
     world: &World,
     tube: &Tube,
     gap: Real,
+    contacts: &[BedContact],
 ) -> Result<Vec<CappedParticle>, GeometryError> {
     let templates = templates(world)?;
     let p = &world.particles;
     let axis = tube.axis.normalize();
     let mut keeps: Vec<Vec<Keep>> = vec![Vec::new(); p.owned()];
-    for c in bed_contacts(world, gap)? {
+    for c in contacts.iter().filter(|c| c.gap <= gap) {
         let at = c.normal.dot(&c.point.coords);
         keeps[c.i].push(Keep {
             normal: c.normal,

@@ -34,6 +34,7 @@
 mod clipped;
 mod coordination;
 pub mod mesher;
+mod near;
 mod reactor;
 
 use nalgebra::{Isometry3, Point3, UnitQuaternion, Vector3};

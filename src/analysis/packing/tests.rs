@@ -334,7 +334,7 @@ fn the_contacts_of_cubes_apart_and_overlapping() {
 /// tube's caps, and little of each is cut off.
 #[test]
 fn capped_spheres_are_closed_and_a_gap_apart() {
-    use super::mesher::capped_particles;
+    use super::mesher::{bed_contacts, capped_particles};
     use crate::geometry::gjk::gjk;
     let (t, gap) = (tube(1.5), 0.01);
     let at = |rho: Real, phi: Real, z: Real| {
@@ -350,7 +350,8 @@ fn capped_spheres_are_closed_and_a_gap_apart() {
         at(0.0, 0.0, 3.0),   // alone
     ];
     let world = world_of(Shape::Sphere(Sphere::new(0.5).unwrap()), &placements);
-    let capped = capped_particles(&world, &t, gap).unwrap();
+    let contacts = bed_contacts(&world, gap).unwrap();
+    let capped = capped_particles(&world, &t, gap, &contacts).unwrap();
     assert_eq!(capped.len(), 6);
     let ball = crate::geometry::generators::icosphere_mesh(2, 0.5).unwrap();
     let ball = ConvexPolyhedron::from_convex_mesh(&ball).unwrap().volume();
