@@ -19,6 +19,9 @@ use talus::geometry::gjk::gjk;
 use talus::geometry::overlap::{OverlapScratch, overlap_with};
 use talus::geometry::wall::polyhedron_triangle;
 
+mod common;
+use common::cpu_model;
+
 const PAIRS: usize = 64;
 
 fn random_rotation(rng: &mut Pcg64) -> UnitQuaternion<f64> {
@@ -87,17 +90,6 @@ fn time_per_call(mut f: impl FnMut() -> usize) -> f64 {
         best = best.min(t.elapsed().as_secs_f64() / (reps * PAIRS) as f64);
     }
     best * 1e9
-}
-
-fn cpu_model() -> String {
-    std::fs::read_to_string("/proc/cpuinfo")
-        .ok()
-        .and_then(|s| {
-            s.lines()
-                .find(|l| l.starts_with("model name"))
-                .map(|l| l.split(':').nth(1).unwrap_or("").trim().to_string())
-        })
-        .unwrap_or_else(|| "unknown CPU".into())
 }
 
 fn main() {

@@ -100,13 +100,48 @@ fn the_fluid_variables_are_sized_by_the_grid_with_their_start_values() {
     );
 }
 
+/// The fluid column on a cylindrical grid about the box's axis (3 annuli out to the
+/// box's corners, 6 slabs, 4 sectors), its shares computed again at the start of
+/// each communication step.
+const CYLINDER: &str = "grid = \"cylindrical\"\nbase = [0.015, 0.015, 0.0]\nradius = 0.0213\n\
+    height = 0.06\ncells = [3, 6, 4]";
+
+/// The column's scene with `[fluid]`'s grid and update interval replaced, in a
+/// directory of its own (removed when the component has read it).
+fn column_with(grid: &str, interval: &str) -> (Component, Scene) {
+    let text = std::fs::read_to_string(root().join(SCENE))
+        .unwrap()
+        .replace(
+            "origin = [0.0, 0.0, 0.0]\ncell = [0.01, 0.01, 0.01]\ncells = [3, 3, 6]",
+            grid,
+        )
+        .replace("update_interval = 5", interval);
+    let dir = std::env::temp_dir().join(format!(
+        "talus-cosim-fluid-{}-{}",
+        std::process::id(),
+        text.len()
+    ));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("column.toml"), &text).unwrap();
+    let c = Component::instantiate(&dir, "column.toml").unwrap();
+    let scene = Scene::load(&dir.join("column.toml")).unwrap();
+    let _ = std::fs::remove_dir_all(&dir);
+    (c, scene)
+}
+
 /// The component against the simulation stepped by hand: the same inputs give the
 /// same bits of every fluid output, and the momentum source is the mean over the
-/// last communication step alone.
+/// last communication step alone; on the structured grid with shares every 5 steps
+/// and on the cylindrical one with shares at each communication step.
 #[test]
 fn the_component_hands_over_what_the_simulation_computes() {
-    let mut c = column();
-    let cells = 54;
+    let (c, scene) = (column(), Scene::load(&root().join(SCENE)).unwrap());
+    hands_over(c, scene, 54, false);
+    let (c, scene) = column_with(CYLINDER, "update_interval = \"communication\"");
+    hands_over(c, scene, 72, true);
+}
+
+fn hands_over(mut c: Component, scene: Scene, cells: usize, each_communication: bool) {
     let first = swirl(cells, 0.0);
     set(&mut c, "fluid.velocity", &first).unwrap();
     c.enter_initialization_mode(0.0).unwrap();
@@ -118,7 +153,6 @@ fn the_component_hands_over_what_the_simulation_computes() {
         "no step yet: no mean"
     );
 
-    let scene = Scene::load(&root().join(SCENE)).unwrap();
     let mut sim = Simulation::new(&scene);
     sim.set_fluid_velocity(&vec3s(&first)).unwrap();
     sim.initialise();
@@ -129,7 +163,8 @@ fn the_component_hands_over_what_the_simulation_computes() {
         set(&mut c, "fluid.velocity", input).unwrap();
         c.do_step(k as Real * h, h).unwrap();
         sim.set_fluid_velocity(&vec3s(input)).unwrap();
-        sim.restart_fluid_exchange();
+        sim.start_communication_step();
+        let at_start = sim.fluid().unwrap().solid_fraction.clone();
         let _ = sim.advance_to((k + 1) as Real * h, |_, _| ControlFlow::<()>::Continue(()));
         let source: Vec<Real> = sim
             .take_momentum_source()
@@ -140,6 +175,10 @@ fn the_component_hands_over_what_the_simulation_computes() {
         let fluid = sim.fluid().unwrap();
         assert_eq!(vector(&c, "fluid.momentum_source"), source, "step {k}");
         assert_eq!(vector(&c, "fluid.solid_fraction"), fluid.solid_fraction);
+        if each_communication {
+            // Shares from the start of the step, held through it.
+            assert_eq!(fluid.solid_fraction, at_start, "step {k}");
+        }
         let mean: Vec<Real> = fluid
             .particle_velocity
             .iter()
@@ -154,8 +193,26 @@ fn the_component_hands_over_what_the_simulation_computes() {
         down < 0.0,
         "the particles take momentum from the gas: {down}"
     );
-    let solid: Real = vector(&c, "fluid.solid_fraction").iter().sum();
-    assert!(solid > 0.5, "{solid}");
+    // The solid fractions times the cells' volumes: every particle's volume (the
+    // cells cover the box; particles pressed into its walls by a little more).
+    let grid = c.fluid_grid().unwrap();
+    let solid: Real = vector(&c, "fluid.solid_fraction")
+        .iter()
+        .enumerate()
+        .map(|(k, phi)| phi * grid.cell_volume(k))
+        .sum();
+    let world = sim.world();
+    let volume: Real = (0..world.particles.len())
+        .map(|i| {
+            world.body_types[world.particles.body_type[i] as usize]
+                .shape
+                .volume()
+        })
+        .sum();
+    assert!(
+        (solid / volume - 1.0).abs() < 1e-3,
+        "{solid} against {volume}"
+    );
 }
 
 #[test]

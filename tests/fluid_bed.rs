@@ -38,7 +38,8 @@ fn porosity(sim: &Simulation) -> Vec<Real> {
 /// the particles took in it, `∇p = ρ_f g − Σf_d / (ε V)`.
 fn set_gas(sim: &mut Simulation, u: Real, drag: &[Vector3<Real>]) {
     let eps = porosity(sim);
-    let volume = sim.fluid().unwrap().grid.cell_volume();
+    // Slabs of one size.
+    let volume = sim.fluid().unwrap().grid.cell_volume(0);
     let velocity: Vec<_> = eps.iter().map(|e| Vector3::new(0.0, 0.0, u / e)).collect();
     let gradient: Vec<_> = eps
         .iter()

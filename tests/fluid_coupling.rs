@@ -258,48 +258,11 @@ fn fluid_inputs_of_the_wrong_size_or_not_finite_are_refused() {
 /// talus, circumradius 5 mm, in a box 0.3155 m square), under a fluid of `grid`
 /// (the lines of `[fluid]` that place it) with the Gidaspow drag.
 fn poured_bed(grid: &str, rho: Real, mu: Real) -> Simulation {
-    let text = format!(
-        r#"
-[simulation]
-dt = 1e-6
-end_time = 1.0
-gravity = [0.0, 0.0, -9.81]
-
-[contact]
-regularisation = 0.2
-
-[materials.pla]
-density = 1500.0
-young = 1e6
-poisson = 0.1
-restitution = 0.5
-friction = 0.5
-
-[shapes.body]
-kind = "platonic"
-solid = "dodecahedron"
-circumradius = 0.005
-
-[[wall]]
-name = "box"
-material = "pla"
-geometry = {{ kind = "box", min = [0.0, 0.0, 0.0], max = [0.3155, 0.3155, 0.2], open_top = true }}
-
-[[particles]]
-kind = "file"
-shape = "body"
-material = "pla"
-file = "settled_dodecahedra.csv"
-
-[fluid]
-{grid}
-density = {rho}
-viscosity = {mu}
-drag = "gidaspow"
-"#
-    );
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("benches/data");
-    Simulation::new(&Scene::parse(&text, &dir.join("bed.toml")).unwrap())
+    let bed = std::fs::read_to_string(dir.join("settled_bed.toml")).unwrap();
+    let text =
+        format!("{bed}\n[fluid]\n{grid}\ndensity = {rho}\nviscosity = {mu}\ndrag = \"gidaspow\"\n");
+    Simulation::new(&Scene::parse(&text, &dir.join("settled_bed.toml")).unwrap())
 }
 
 #[test]
@@ -313,8 +276,8 @@ fn the_solid_fractions_of_a_poured_bed_add_up_to_its_volume() {
         1e-3,
     );
     let fluid = sim.fluid().unwrap();
-    let total: Real = fluid.solid_fraction.iter().sum::<Real>() * fluid.grid.cell_volume();
     let volume = sim.world().particles.len() as Real * sim.world().body_types[0].shape.volume();
+    let total = solid_volume(&sim);
     assert!(
         (total / volume - 1.0).abs() < 1e-12,
         "{total} against {volume}"
@@ -329,6 +292,93 @@ fn the_solid_fractions_of_a_poured_bed_add_up_to_its_volume() {
         (lo.min(s), hi.max(s))
     });
     assert!(lo < 0.45 && hi > 0.55, "solid fractions {lo}..{hi}");
+}
+
+/// Σ solid fraction × cell volume over the fluid's cells.
+fn solid_volume(sim: &Simulation) -> Real {
+    let fluid = sim.fluid().unwrap();
+    fluid
+        .solid_fraction
+        .iter()
+        .enumerate()
+        .map(|(c, phi)| phi * fluid.grid.cell_volume(c))
+        .sum()
+}
+
+#[test]
+fn a_poured_bed_on_cylindrical_and_given_cells() {
+    let volume = |sim: &Simulation| {
+        sim.world().particles.len() as Real * sim.world().body_types[0].shape.volume()
+    };
+    // A tube about the box's axis out past its corners, 12 annuli of which the outer
+    // ones are cut by the walls, 8 sectors: the shares add up to the bed.
+    let sim = poured_bed(
+        "grid = \"cylindrical\"\nbase = [0.15775, 0.15775, -0.01]\nradius = 0.225\n\
+         height = 0.2\ncells = [12, 10, 8]",
+        1000.0,
+        1e-3,
+    );
+    let total = solid_volume(&sim);
+    assert!(
+        (total / volume(&sim) - 1.0).abs() < 1e-12,
+        "{total} against {}",
+        volume(&sim)
+    );
+    // The outermost annulus lies beyond the walls but for the corners: nearly empty;
+    // the inner ones hold the bed (a solid fraction near 0.6 below its surface).
+    let fluid = sim.fluid().unwrap();
+    let talus::fluid::FluidGrid::Cylindrical(grid) = &fluid.grid else {
+        panic!("cylindrical")
+    };
+    let of = |i: usize| {
+        (0..fluid.grid.len())
+            .filter(|&c| grid.cell(c)[0] == i && grid.cell(c)[1] == 2)
+            .map(|c| fluid.solid_fraction[c])
+            .sum::<Real>()
+            / 8.0
+    };
+    assert!(
+        of(11) < 0.1 && of(2) > 0.4 && of(2) < 0.75,
+        "{} {}",
+        of(11),
+        of(2)
+    );
+
+    // The structured grid's cells given by their centres and volumes: the same
+    // solid fractions (the Voronoi cells of a structured grid's centres are its
+    // cells; dodecahedra are cut exactly both ways).
+    let h = 0.3155 / 18.0;
+    let structured = poured_bed(
+        &format!("origin = [-{h}, -{h}, -{h}]\ncell = [{h}, {h}, {h}]\ncells = [20, 20, 7]"),
+        1000.0,
+        1e-3,
+    );
+    let grid = &structured.fluid().unwrap().grid;
+    let mut csv = String::from("x,y,z,volume\n");
+    for c in 0..grid.len() {
+        let p = grid.centre(c);
+        csv += &format!("{:e},{:e},{:e},{:e}\n", p.x, p.y, p.z, grid.cell_volume(c));
+    }
+    let file = std::env::temp_dir().join(format!("talus-cells-{}.csv", std::process::id()));
+    std::fs::write(&file, csv).unwrap();
+    let given = poured_bed(
+        &format!("grid = \"cells\"\nfile = \"{}\"", file.display()),
+        1000.0,
+        1e-3,
+    );
+    let _ = std::fs::remove_file(&file);
+    let (a, b) = (
+        &structured.fluid().unwrap().solid_fraction,
+        &given.fluid().unwrap().solid_fraction,
+    );
+    assert_eq!(a.len(), b.len());
+    let worst = a
+        .iter()
+        .zip(b)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, Real::max);
+    assert!(worst < 1e-12, "largest difference {worst}");
+    assert!(a.iter().any(|&x| x > 0.4));
 }
 
 /// The pressure drop a 1-D fluid model (the reactor and plug-flow models' grid:
@@ -469,8 +519,20 @@ update_interval = 5
 }
 
 /// The scene of glass beads in a box under an upward water flow, with `fluid` as the
-/// `[fluid]` section's keys after the grid.
+/// `[fluid]` section's keys (after a structured grid's origin and cell size unless
+/// they name a `grid`).
+/// `[fluid]` of a cylindrical grid about the beads' box (3 annuli out to its
+/// corners, 6 slabs, 4 sectors) in water.
+const CYLINDER_KEYS: &str = "grid = \"cylindrical\"\nbase = [0.015, 0.015, 0.0]\nradius = 0.0213\n\
+    height = 0.06\ncells = [3, 6, 4]\ndensity = 1000.0\nviscosity = 1e-3\ndrag = \"gidaspow\"\n";
+
 fn beads_in_water(fluid: &str) -> String {
+    // A structured grid of 1 cm cells unless the keys name another kind.
+    let grid = if fluid.contains("grid = ") {
+        ""
+    } else {
+        "origin = [0.0, 0.0, 0.0]\ncell = [0.01, 0.01, 0.01]\n"
+    };
     format!(
         r#"
 [simulation]
@@ -505,9 +567,7 @@ min = [0.0, 0.0, 0.0]
 max = [0.03, 0.03, 0.02]
 
 [fluid]
-origin = [0.0, 0.0, 0.0]
-cell = [0.01, 0.01, 0.01]
-{fluid}
+{grid}{fluid}
 "#
     )
 }
@@ -554,25 +614,30 @@ fn talus_run_writes_the_fluid_grid_for_paraview() {
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("fluid_run");
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
-    let scene = dir.join("beads.toml");
+    let scene_file = dir.join("beads.toml");
     std::fs::write(
-        &scene,
+        &scene_file,
         beads_in_water(
             "cells = [3, 3, 6]\ndensity = 1000.0\nviscosity = 1e-3\ndrag = \"di_felice\"\nvelocity = [0.0, 0.0, 0.05]",
         ),
     )
     .unwrap();
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_talus"))
-        .args(["run", "--quiet", "--threads", "2", "--out"])
-        .arg(dir.join("out"))
-        .arg(&scene)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    // `talus run --quiet --threads 2 ARGS beads.toml` in `dir`: Ok, or its stderr.
+    let run = |args: &[&str]| {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_talus"))
+            .current_dir(&dir)
+            .args(["run", "--quiet", "--threads", "2"])
+            .args(args)
+            .arg(&scene_file)
+            .output()
+            .unwrap();
+        if out.status.success() {
+            Ok(())
+        } else {
+            Err(String::from_utf8_lossy(&out.stderr).into_owned())
+        }
+    };
+    run(&["--out", "out"]).unwrap();
     let pvd = std::fs::read_to_string(dir.join("out/fluid.pvd")).unwrap();
     for t in ["0.000000000e0", "1.000000000e-3", "2.000000000e-3"] {
         assert!(pvd.contains(&format!("timestep=\"{t}\"")), "{pvd}");
@@ -583,7 +648,7 @@ fn talus_run_writes_the_fluid_grid_for_paraview() {
     assert_eq!(get("fluid_velocity").len(), 3 * 54);
     // The beads' volume, in single precision; the flow drags them upward.
     let solid: f64 = get("solid_fraction").iter().sum::<f64>() * 1e-6;
-    let scene = Scene::load(&scene).unwrap();
+    let scene = Scene::load(&scene_file).unwrap();
     let beads =
         scene.world.particles.len() as f64 * 4.0 / 3.0 * std::f64::consts::PI * 0.002f64.powi(3);
     assert!(
@@ -616,6 +681,42 @@ fn talus_run_writes_the_fluid_grid_for_paraview() {
         }
     }
     assert!((total / lift - 1.0).abs() < 1e-5, "{total} against {lift}");
+
+    // On a cylindrical grid: points at the cells' middles, with their volumes.
+    std::fs::write(&scene_file, beads_in_water(CYLINDER_KEYS)).unwrap();
+    run(&["--out", "cylinder"]).unwrap();
+    let arrays = read_vtk(&dir.join("cylinder/frames/fluid_000002.vtp"));
+    let get = |n: &str| &arrays.iter().find(|a| a.0 == n).unwrap().1;
+    assert_eq!(get("solid_fraction").len(), 72);
+    let solid: f64 = get("solid_fraction")
+        .iter()
+        .zip(get("cell_volume"))
+        .map(|(phi, v)| phi * v)
+        .sum();
+    assert!(
+        (solid / beads - 1.0).abs() < 1e-5,
+        "{solid} against {beads}"
+    );
+    let volume: f64 = get("cell_volume").iter().sum();
+    let tube = std::f64::consts::PI * 0.0213f64.powi(2) * 0.06;
+    assert!(
+        (volume / tube - 1.0).abs() < 1e-6,
+        "{volume} against {tube}"
+    );
+
+    // Shares at each communication step: a coupled run's setting, refused here.
+    std::fs::write(
+        &scene_file,
+        beads_in_water(&format!(
+            "{CYLINDER_KEYS}update_interval = \"communication\""
+        )),
+    )
+    .unwrap();
+    let err = run(&["--out", "refused"]).unwrap_err();
+    assert!(
+        err.contains("update_interval = \"communication\" needs a coupled run"),
+        "{err}"
+    );
 }
 
 #[test]
@@ -641,6 +742,38 @@ fn a_bad_fluid_section_names_its_field() {
             "fluid.update_interval",
             "at least 1",
         ),
+        (
+            "cells = [3, 3, 6]\ndensity = 1000.0\nviscosity = 1e-3\ndrag = \"gidaspow\"\nupdate_interval = \"often\"",
+            "beads.toml:",
+            "\"often\": expected a number of steps or \"communication\"",
+        ),
+        (
+            "cells = [3, 3, 6]\nradius = 0.02\ndensity = 1000.0\nviscosity = 1e-3\ndrag = \"gidaspow\"",
+            "fluid.radius",
+            "not a key of a cartesian grid",
+        ),
+        (
+            CYLINDER_KEYS.replace("radius = 0.0213\n", "").as_str(),
+            "fluid.radius",
+            "either radius or radii",
+        ),
+        (
+            CYLINDER_KEYS
+                .replace("radius = 0.0213", "radii = [0.01, 0.005, 0.02]")
+                .as_str(),
+            "fluid.radii",
+            "ascending",
+        ),
+        (
+            CYLINDER_KEYS.replace("height = 0.06\n", "").as_str(),
+            "fluid.height",
+            "needs it",
+        ),
+        (
+            "grid = \"cells\"\nfile = \"no_such_cells.csv\"\ndensity = 1000.0\nviscosity = 1e-3\ndrag = \"gidaspow\"",
+            "fluid.file",
+            "no_such_cells.csv: cannot read",
+        ),
     ] {
         let err = Scene::parse(&beads_in_water(keys), Path::new("beads.toml"))
             .unwrap_err()
@@ -650,4 +783,32 @@ fn a_bad_fluid_section_names_its_field() {
             "{err}"
         );
     }
+    // A cells file's errors name its line (comments and blank lines counted).
+    let file = std::env::temp_dir().join(format!("talus-bad-cells-{}.csv", std::process::id()));
+    for (text, what) in [
+        (
+            "# cells\nx,y,z,volume\n0,0,0,1e-6\n\n0.01,0,zero,1e-6\n",
+            ":5: column 'z': 'zero' is not a number",
+        ),
+        (
+            "x,y,z,volume\n0,0,0,1e-6\n0.01,0,0,-1e-6\n",
+            ":3: the volume -0.000001 is not positive",
+        ),
+        (
+            "x,y,z,volume\n0,0,0,1e-6\n# the same again\n0,0,0,1e-6\n",
+            ":4: cell 1: the same centre as cell 0",
+        ),
+        ("x,y,volume\n0,0,1e-6\n", ":1: the header has no column 'z'"),
+    ] {
+        std::fs::write(&file, text).unwrap();
+        let keys = format!(
+            "grid = \"cells\"\nfile = \"{}\"\ndensity = 1000.0\nviscosity = 1e-3\ndrag = \"gidaspow\"",
+            file.display()
+        );
+        let err = Scene::parse(&beads_in_water(&keys), Path::new("beads.toml"))
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("fluid.file") && err.contains(what), "{err}");
+    }
+    let _ = std::fs::remove_file(&file);
 }

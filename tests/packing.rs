@@ -167,6 +167,29 @@ fn a_run_writes_the_packing_and_analyze_reproduces_it() {
         "60 icospheres of 320 triangles"
     );
     assert!(out.join("packing_radial.csv").exists() && out.join("packing_axial.csv").exists());
+    // Both profiles at once on the cells of a cylindrical grid (radial bins × axial
+    // slices): every cell of the first slab above the region's start, weighted by
+    // its annulus, gives that slab's porosity in packing_axial.csv.
+    let cells = std::fs::read_to_string(out.join("packing_cells.csv")).unwrap();
+    let rows: Vec<Vec<f64>> = cells
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+        .collect();
+    let axial = first["axial"].as_array().unwrap();
+    assert_eq!(rows.len(), radial.len() * axial.len());
+    for (j, s) in axial.iter().enumerate() {
+        let weighted: f64 = rows
+            .iter()
+            .filter(|r| r[1] == j as f64)
+            .map(|r| r[9] * (r[4] * r[4] - r[3] * r[3]))
+            .sum();
+        let expected = s["porosity"].as_f64().unwrap();
+        assert!(
+            (weighted / 1e-4 - expected).abs() < 1e-7,
+            "slab {j}: {weighted}"
+        );
+    }
     // The capped bed for a CFD mesher: 60 closed shells, every two at least the
     // gap (d/100) apart, and the contacts they were capped at.
     check_capped_stl(&out.join("bed_caps.stl"), 5e-5, 60);

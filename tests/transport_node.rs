@@ -161,6 +161,11 @@ async fn a_client_exchanges_the_fluid_fields_with_the_served_column() {
     let grid = fields.grid.as_ref().unwrap();
     assert_eq!(grid.counts, [3, 3, 6]);
     assert_eq!(grid.cell.unwrap().z, 0.01);
+    // Every kind of cells comes with centres and volumes: cell [1, 2, 3].
+    assert_eq!((grid.kind.as_str(), grid.volumes.len()), ("cartesian", 54));
+    let k = 1 + 3 * (2 + 3 * 3);
+    assert_eq!(&grid.centres[3 * k..3 * k + 3], &[0.015, 0.025, 0.035]);
+    assert!((grid.volumes[k] - 1e-6).abs() < 1e-20);
     assert_eq!(fields.velocity, velocity);
     assert_eq!(fields.momentum_source, read("fluid.momentum_source"));
     assert_eq!(fields.solid_fraction, read("fluid.solid_fraction"));

@@ -178,10 +178,11 @@ int talus_get_facet_forces(struct talus_component *handle,
                            double *forces,
                            size_t n_triangles);
 
-// The fluid grid of a scene with `[fluid]`: the lower corner of its first cell, the
-// cell edges and the cell counts along x, y and z (3 values each). Per-cell arrays
-// (`fluid.velocity`, `fluid.solid_fraction` ...; see `talus_get_real`) run x fastest,
-// then y, then z, with x y z per cell for vectors.
+// The structured fluid grid of a scene with `[fluid]` (`grid = "cartesian"`): the
+// lower corner of its first cell, the cell edges and the cell counts along x, y and
+// z (3 values each). Per-cell arrays (`fluid.velocity`, `fluid.solid_fraction` ...;
+// see `talus_get_real`) run x fastest, then y, then z, with x y z per cell for
+// vectors. Other kinds of cells: an error (see `talus_get_fluid_cells`).
 //
 // # Safety
 // `handle` is a live component; `origin`, `cell` and `counts` have room for 3 values.
@@ -189,6 +190,24 @@ int talus_get_fluid_grid(struct talus_component *handle,
                          double *origin,
                          double *cell,
                          size_t *counts);
+
+// The number of fluid cells of a scene with `[fluid]` (any kind of grid).
+//
+// # Safety
+// `handle` is a live component; `count` points to writable memory.
+int talus_get_fluid_cell_count(struct talus_component *handle, size_t *count);
+
+// Every fluid cell's centre (x y z per cell: a cylindrical grid's cell at
+// mid-radius, mid-angle and mid-height) and volume, in the order of the per-cell
+// arrays; `n` is the number of cells (`talus_get_fluid_cell_count`), `centres` has
+// room for `3 n` values and `volumes` for `n`.
+//
+// # Safety
+// `handle` is a live component; `centres` and `volumes` have room as stated.
+int talus_get_fluid_cells(struct talus_component *handle,
+                          size_t n,
+                          double *centres,
+                          double *volumes);
 
 // Reads the `n` values of the real variable called `name`.
 //

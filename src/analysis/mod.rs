@@ -8,7 +8,6 @@
 pub mod drum;
 pub mod field;
 pub mod packing;
-pub mod section;
 pub mod surface;
 
 pub use drum::{Drum, DrumMonitor, DrumRow, DrumSummary, Revolution};

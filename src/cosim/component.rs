@@ -403,8 +403,9 @@ impl Component {
         let pool = self.pool.as_ref().expect("a running component has a pool");
         // Rollback through the saved state, not a copy of the whole simulation.
         let before = sim.snapshot();
-        // The momentum source is the mean over this step.
-        sim.restart_fluid_exchange();
+        // The momentum source is the mean over this step (and the shares are new
+        // with update_interval = "communication").
+        sim.start_communication_step();
         let balance = EnergyBalance::start(sim);
         // A start within round-off before the component's time must not take the
         // clock back.

@@ -389,8 +389,10 @@ pub fn variable_table(scene: &Scene) -> Vec<Variable> {
     v
 }
 
-/// The variables of a fluid grid of `cells` cells, flat in the grid's order (x
-/// fastest), x y z per cell for vectors.
+/// The variables of a fluid grid of `cells` cells, flat in the grid's order (see
+/// [`crate::fluid::FluidGrid`]: x fastest on a structured grid, the annulus fastest
+/// on a cylindrical one, the file's order for given cells), x y z per cell for
+/// vectors.
 fn fluid_variables(cells: usize) -> Vec<Variable> {
     use Causality::*;
     let per_cell = [

@@ -443,10 +443,11 @@ pub unsafe extern "C" fn talus_get_facet_forces(
     })
 }
 
-/// The fluid grid of a scene with `[fluid]`: the lower corner of its first cell, the
-/// cell edges and the cell counts along x, y and z (3 values each). Per-cell arrays
-/// (`fluid.velocity`, `fluid.solid_fraction` ...; see `talus_get_real`) run x fastest,
-/// then y, then z, with x y z per cell for vectors.
+/// The structured fluid grid of a scene with `[fluid]` (`grid = "cartesian"`): the
+/// lower corner of its first cell, the cell edges and the cell counts along x, y and
+/// z (3 values each). Per-cell arrays (`fluid.velocity`, `fluid.solid_fraction` ...;
+/// see `talus_get_real`) run x fastest, then y, then z, with x y z per cell for
+/// vectors. Other kinds of cells: an error (see `talus_get_fluid_cells`).
 ///
 /// # Safety
 /// `handle` is a live component; `origin`, `cell` and `counts` have room for 3 values.
@@ -467,9 +468,64 @@ pub unsafe extern "C" fn talus_get_fluid_grid(
                 slice_mut(counts, 3, "counts")?,
             )
         };
+        let grid = grid.as_cartesian().ok_or_else(|| {
+            format!(
+                "the fluid's cells are {}, not a structured grid: talus_get_fluid_cells gives them",
+                grid.kind()
+            )
+        })?;
         o.copy_from_slice(grid.origin().coords.as_slice());
         c.copy_from_slice(grid.cell_size().as_slice());
         n.copy_from_slice(&grid.counts());
+        Ok(())
+    })
+}
+
+/// The number of fluid cells of a scene with `[fluid]` (any kind of grid).
+///
+/// # Safety
+/// `handle` is a live component; `count` points to writable memory.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn talus_get_fluid_cell_count(
+    handle: *mut TalusComponent,
+    count: *mut usize,
+) -> c_int {
+    with(handle, |h| {
+        let cells = h.component.fluid_grid().map_err(|e| e.to_string())?.len();
+        unsafe { slice_mut(count, 1, "count") }?[0] = cells;
+        Ok(())
+    })
+}
+
+/// Every fluid cell's centre (x y z per cell: a cylindrical grid's cell at
+/// mid-radius, mid-angle and mid-height) and volume, in the order of the per-cell
+/// arrays; `n` is the number of cells (`talus_get_fluid_cell_count`), `centres` has
+/// room for `3 n` values and `volumes` for `n`.
+///
+/// # Safety
+/// `handle` is a live component; `centres` and `volumes` have room as stated.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn talus_get_fluid_cells(
+    handle: *mut TalusComponent,
+    n: usize,
+    centres: *mut f64,
+    volumes: *mut f64,
+) -> c_int {
+    with(handle, |h| {
+        let grid = h.component.fluid_grid().map_err(|e| e.to_string())?;
+        if n != grid.len() {
+            return Err(format!("n is {n}, the fluid has {} cells", grid.len()));
+        }
+        let (c, v) = unsafe {
+            (
+                slice_mut(centres, 3 * n, "centres")?,
+                slice_mut(volumes, n, "volumes")?,
+            )
+        };
+        for k in 0..n {
+            c[3 * k..3 * k + 3].copy_from_slice(grid.centre(k).coords.as_slice());
+            v[k] = grid.cell_volume(k);
+        }
         Ok(())
     })
 }

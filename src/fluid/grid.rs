@@ -1,9 +1,12 @@
-//! The fluid's grid as talus sees it: axis-aligned cells of one size.
+//! The fluid's cells as talus sees them: a structured grid, a cylindrical grid
+//! about a tube's axis, or cells a coupled code gives by their centres and volumes.
+//! Each kind splits a particle's volume among its cells exactly (see its module).
 
-use nalgebra::{Point3, Vector3};
+use nalgebra::Point3;
 
+use super::{CartesianGrid, CylindricalGrid, GivenCells};
 use crate::Real;
-use crate::geometry::cell_volumes::CellBounds;
+use crate::geometry::{Pose, Shape};
 
 /// The most cells a grid may have.
 pub const MAX_CELLS: usize = 50_000_000;
@@ -11,132 +14,154 @@ pub const MAX_CELLS: usize = 50_000_000;
 /// Why numbers make no grid.
 #[derive(Debug, thiserror::Error, PartialEq)]
 pub enum GridError {
-    /// A corner that is not finite.
+    /// A corner or base that is not finite.
     #[error("must be finite")]
-    Origin,
+    NotFinite(&'static str),
     /// A cell edge that is not positive.
     #[error("cell sizes must be positive, got {0:?}")]
     CellSize([Real; 3]),
     /// No cells along an axis, or too many in all.
     #[error("cell counts must be at least 1 and at most {MAX_CELLS} in all, got {0:?}")]
     Counts([usize; 3]),
+    /// An axis that is zero or not finite.
+    #[error("must be a finite, non-zero vector")]
+    Axis,
+    /// Radii that are not positive, finite and ascending.
+    #[error("radii must be positive, finite and ascending, got {0:?}")]
+    Radii(Vec<Real>),
+    /// A height that is not positive.
+    #[error("must be positive and finite, got {0}")]
+    Height(Real),
+    /// A cell whose centre is not finite or whose volume is not positive.
+    #[error("cell {cell}: {what}")]
+    Cell {
+        /// The cell's index (from 0).
+        cell: usize,
+        /// What is wrong.
+        what: String,
+    },
 }
 
 impl GridError {
     /// The `[fluid]` key the error is about.
     pub fn key(&self) -> &'static str {
         match self {
-            GridError::Origin => "origin",
+            GridError::NotFinite(key) => key,
             GridError::CellSize(_) => "cell",
             GridError::Counts(_) => "cells",
+            GridError::Axis => "axis",
+            GridError::Radii(_) => "radii",
+            GridError::Height(_) => "height",
+            GridError::Cell { .. } => "file",
         }
     }
 }
 
-/// A structured grid of `counts` cells of size `cell` from `origin`.
+/// The fluid's cells.
 ///
 /// # Invariant
-/// Cell sizes are positive and finite, counts at least 1; cell `[i, j, k]` has the
-/// flat index `i + nx (j + ny k)` (x fastest), the order of every per-cell array.
+/// Every per-cell array of the coupling has one entry per cell, in the grid's flat
+/// order (see each kind); cells do not overlap, so a particle's shares add up to
+/// at most its volume (to its volume when the cells cover it).
 #[derive(Clone, Debug, PartialEq)]
-pub struct FluidGrid {
-    origin: Point3<Real>,
-    cell: Vector3<Real>,
-    counts: [usize; 3],
-    bounds: [Vec<Real>; 3],
+pub enum FluidGrid {
+    /// Axis-aligned cells of one size.
+    Cartesian(CartesianGrid),
+    /// Annuli × slabs × sectors about a tube's axis.
+    Cylindrical(CylindricalGrid),
+    /// The Voronoi cells of centres a coupled code gives, with its volumes.
+    Given(GivenCells),
 }
 
 impl FluidGrid {
-    /// A grid, or why the numbers make none.
-    pub fn new(
-        origin: Point3<Real>,
-        cell: Vector3<Real>,
-        counts: [usize; 3],
-    ) -> Result<Self, GridError> {
-        if !origin.coords.iter().all(|x| x.is_finite()) {
-            return Err(GridError::Origin);
-        }
-        if !cell.iter().all(|&h| h > 0.0 && h.is_finite()) {
-            return Err(GridError::CellSize(cell.into()));
-        }
-        if counts.contains(&0) || counts.iter().product::<usize>() > MAX_CELLS {
-            return Err(GridError::Counts(counts));
-        }
-        let bounds = std::array::from_fn(|a| {
-            (0..=counts[a])
-                .map(|k| origin[a] + cell[a] * k as Real)
-                .collect()
-        });
-        Ok(FluidGrid {
-            origin,
-            cell,
-            counts,
-            bounds,
-        })
-    }
-
     /// Number of cells.
     pub fn len(&self) -> usize {
-        self.counts.iter().product()
+        match self {
+            FluidGrid::Cartesian(g) => g.len(),
+            FluidGrid::Cylindrical(g) => g.len(),
+            FluidGrid::Given(g) => g.len(),
+        }
     }
 
-    /// Whether the grid has no cells (never: see the invariant).
+    /// Whether the grid has no cells (never: each kind has at least one).
     pub fn is_empty(&self) -> bool {
         self.len() == 0
     }
 
-    /// The lower corner of cell `[0, 0, 0]`.
-    pub fn origin(&self) -> Point3<Real> {
-        self.origin
+    /// The name of the kind, as `[fluid] grid` spells it.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            FluidGrid::Cartesian(_) => "cartesian",
+            FluidGrid::Cylindrical(_) => "cylindrical",
+            FluidGrid::Given(_) => "cells",
+        }
     }
 
-    /// Cells along each axis.
-    pub fn counts(&self) -> [usize; 3] {
-        self.counts
+    /// The grid in words (for a run's plan).
+    pub fn describe(&self) -> String {
+        match self {
+            FluidGrid::Cartesian(g) => {
+                let ([nx, ny, nz], h) = (g.counts(), g.cell_size());
+                format!(
+                    "{nx} × {ny} × {nz} cells of {:.4e} × {:.4e} × {:.4e} m",
+                    h.x, h.y, h.z
+                )
+            }
+            FluidGrid::Cylindrical(g) => {
+                let [nr, nz, nt] = g.counts();
+                format!(
+                    "cylindrical, {nr} annuli × {nz} slabs × {nt} sectors, radius {:.4e} m, height {:.4e} m",
+                    g.radii()[nr - 1],
+                    g.heights()[nz]
+                )
+            }
+            FluidGrid::Given(g) => format!("{} cells given by their centres", g.len()),
+        }
     }
 
-    /// Volume of one cell.
-    pub fn cell_volume(&self) -> Real {
-        self.cell.product()
+    /// The structured grid, if the cells are one.
+    pub fn as_cartesian(&self) -> Option<&CartesianGrid> {
+        match self {
+            FluidGrid::Cartesian(g) => Some(g),
+            _ => None,
+        }
     }
 
-    /// Size of a cell along each axis.
-    pub fn cell_size(&self) -> Vector3<Real> {
-        self.cell
+    /// Volume of cell `c`.
+    pub fn cell_volume(&self, c: usize) -> Real {
+        match self {
+            FluidGrid::Cartesian(g) => g.cell_volume(),
+            FluidGrid::Cylindrical(g) => g.cell_volume(c),
+            FluidGrid::Given(g) => g.cell_volume(c),
+        }
     }
 
-    /// The cell boundaries along each axis.
-    pub fn bounds(&self) -> CellBounds<'_> {
-        [&self.bounds[0], &self.bounds[1], &self.bounds[2]]
-    }
-
-    /// Flat index of cell `c`.
-    pub fn index(&self, c: [usize; 3]) -> usize {
-        c[0] + self.counts[0] * (c[1] + self.counts[1] * c[2])
-    }
-
-    /// Centre of the cell of flat index `n`.
-    pub fn centre(&self, n: usize) -> Point3<Real> {
-        let c = [
-            n % self.counts[0],
-            (n / self.counts[0]) % self.counts[1],
-            n / (self.counts[0] * self.counts[1]),
-        ];
-        Point3::from(Vector3::from_fn(|a, _| {
-            self.origin[a] + self.cell[a] * (c[a] as Real + 0.5)
-        }))
+    /// A point in the middle of cell `c` (the cell's centre for the structured and
+    /// given kinds; mid-radius, mid-angle, mid-height for the cylindrical one).
+    pub fn centre(&self, c: usize) -> Point3<Real> {
+        match self {
+            FluidGrid::Cartesian(g) => g.centre(c),
+            FluidGrid::Cylindrical(g) => g.centre(c),
+            FluidGrid::Given(g) => g.centre(c),
+        }
     }
 
     /// Flat index of the cell holding `p`, if any.
     pub fn cell_of(&self, p: &Point3<Real>) -> Option<usize> {
-        let mut c = [0; 3];
-        for (a, c) in c.iter_mut().enumerate() {
-            let x = ((p[a] - self.origin[a]) / self.cell[a]).floor();
-            if !(x >= 0.0 && x < self.counts[a] as Real) {
-                return None;
-            }
-            *c = x as usize;
+        match self {
+            FluidGrid::Cartesian(g) => g.cell_of(p),
+            FluidGrid::Cylindrical(g) => g.cell_of(p),
+            FluidGrid::Given(g) => Some(g.cell_of(p)),
         }
-        Some(self.index(c))
+    }
+
+    /// The cells `shape` at `pose` reaches, ascending, with its volume in each
+    /// (positive).
+    pub fn shares(&self, shape: &Shape, pose: &Pose) -> Vec<(u32, Real)> {
+        match self {
+            FluidGrid::Cartesian(g) => g.shares(shape, pose),
+            FluidGrid::Cylindrical(g) => g.shares(shape, pose),
+            FluidGrid::Given(g) => g.shares(shape, pose),
+        }
     }
 }

@@ -30,7 +30,7 @@ use crate::Real;
 pub type CellBounds<'a> = [&'a [Real]; 3];
 
 /// A convex body as its face loops (each a planar convex polygon, either orientation).
-type Faces = Vec<Vec<Point3<Real>>>;
+pub(crate) type Faces = Vec<Vec<Point3<Real>>>;
 
 /// The face loops of `shape` placed at `pose` (what [`polyhedron_cell_volumes`]
 /// takes).
@@ -70,12 +70,12 @@ fn slices(body: Faces, axis: usize, bounds: &[Real]) -> Vec<(usize, Faces)> {
     let Some(&first) = bounds.first() else {
         return out;
     };
-    let (_, mut rest) = split(body, axis, first);
+    let (_, mut rest) = split(body, &Cut::axis(axis, first));
     for (k, &cut) in bounds.iter().enumerate().skip(1) {
         if rest.is_empty() {
             break;
         }
-        let (below, above) = split(rest, axis, cut);
+        let (below, above) = split(rest, &Cut::axis(axis, cut));
         if !below.is_empty() {
             out.push((k - 1, below));
         }
@@ -84,19 +84,87 @@ fn slices(body: Faces, axis: usize, bounds: &[Real]) -> Vec<(usize, Faces)> {
     out
 }
 
-/// The parts of a convex body below and above the plane `x[axis] = cut`, each closed
-/// by the section polygon. A part that is empty has no faces.
-fn split(body: Faces, axis: usize, cut: Real) -> (Faces, Faces) {
-    let (lo, hi) = body
-        .iter()
-        .flatten()
-        .fold((Real::INFINITY, Real::NEG_INFINITY), |(lo, hi), p| {
-            (lo.min(p[axis]), hi.max(p[axis]))
-        });
-    if hi <= cut {
+/// A plane that cuts a body: `normal · x = offset`, below where `normal · x` is
+/// smaller. A plane of constant `x[axis]` keeps its axis so that the cut is taken
+/// on that coordinate alone (and the section's points lie exactly on it).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Cut {
+    normal: Vector3<Real>,
+    offset: Real,
+    axis: Option<usize>,
+}
+
+impl Cut {
+    /// The plane `x[axis] = at`.
+    pub(crate) fn axis(axis: usize, at: Real) -> Self {
+        Cut {
+            normal: Vector3::ith(axis, 1.0),
+            offset: at,
+            axis: Some(axis),
+        }
+    }
+
+    /// The plane `normal · x = offset`.
+    pub(crate) fn plane(normal: Vector3<Real>, offset: Real) -> Self {
+        Cut {
+            normal,
+            offset,
+            axis: None,
+        }
+    }
+
+    /// The plane's normal (not necessarily unit).
+    pub(crate) fn normal(&self) -> Vector3<Real> {
+        self.normal
+    }
+
+    /// The plane's offset along its normal.
+    pub(crate) fn offset(&self) -> Real {
+        self.offset
+    }
+
+    fn height(&self, p: &Point3<Real>) -> Real {
+        match self.axis {
+            Some(a) => p[a],
+            None => self.normal.dot(&p.coords),
+        }
+    }
+
+    /// Two unit vectors spanning the plane.
+    fn basis(&self) -> (Vector3<Real>, Vector3<Real>) {
+        match self.axis {
+            Some(a) => (
+                Vector3::ith((a + 1) % 3, 1.0),
+                Vector3::ith((a + 2) % 3, 1.0),
+            ),
+            None => {
+                let n = self.normal.normalize();
+                let seed = if n.x.abs() < 0.6 {
+                    Vector3::x()
+                } else {
+                    Vector3::y()
+                };
+                let u = n.cross(&seed).normalize();
+                (u, n.cross(&u))
+            }
+        }
+    }
+}
+
+/// The parts of a convex body below and above the plane of `cut`, each closed by
+/// the section polygon. A part that is empty has no faces.
+pub(crate) fn split(body: Faces, cut: &Cut) -> (Faces, Faces) {
+    let (lo, hi) =
+        body.iter()
+            .flatten()
+            .fold((Real::INFINITY, Real::NEG_INFINITY), |(lo, hi), p| {
+                let h = cut.height(p);
+                (lo.min(h), hi.max(h))
+            });
+    if hi <= cut.offset {
         return (body, Vec::new());
     }
-    if lo >= cut {
+    if lo >= cut.offset {
         return (Vec::new(), body);
     }
     let (mut below, mut above, mut section) = (Vec::new(), Vec::new(), Vec::new());
@@ -105,7 +173,7 @@ fn split(body: Faces, axis: usize, cut: Real) -> (Faces, Faces) {
         let mut up = Vec::with_capacity(face.len() + 1);
         for (n, &p) in face.iter().enumerate() {
             let q = face[(n + 1) % face.len()];
-            let (s, t) = (p[axis] - cut, q[axis] - cut);
+            let (s, t) = (cut.height(&p) - cut.offset, cut.height(&q) - cut.offset);
             if s <= 0.0 {
                 down.push(p);
             }
@@ -117,7 +185,9 @@ fn split(body: Faces, axis: usize, cut: Real) -> (Faces, Faces) {
             }
             if (s < 0.0 && t > 0.0) || (s > 0.0 && t < 0.0) {
                 let mut x = p + (q - p) * (s / (s - t));
-                x[axis] = cut;
+                if let Some(a) = cut.axis {
+                    x[a] = cut.offset;
+                }
                 down.push(x);
                 up.push(x);
                 section.push(x);
@@ -129,30 +199,35 @@ fn split(body: Faces, axis: usize, cut: Real) -> (Faces, Faces) {
             }
         }
     }
-    if let Some(cap) = convex_loop(section, axis) {
+    if let Some(cap) = convex_loop(section, cut.basis()) {
         below.push(cap.clone());
         above.push(cap);
     }
     (below, above)
 }
 
-/// The points of a convex section in the plane normal to `axis`, ordered around
+/// The points of a convex section in the plane spanned by `basis`, ordered around
 /// their mean (duplicates stay: they add nothing to an area).
-fn convex_loop(mut points: Vec<Point3<Real>>, axis: usize) -> Option<Vec<Point3<Real>>> {
+fn convex_loop(
+    mut points: Vec<Point3<Real>>,
+    (a, b): (Vector3<Real>, Vector3<Real>),
+) -> Option<Vec<Point3<Real>>> {
     if points.len() < 3 {
         return None;
     }
-    let (a, b) = ((axis + 1) % 3, (axis + 2) % 3);
     let n = points.len() as Real;
     let centre = points.iter().fold(Vector3::zeros(), |s, p| s + p.coords) / n;
-    let angle = |p: &Point3<Real>| (p[b] - centre[b]).atan2(p[a] - centre[a]);
+    let angle = |p: &Point3<Real>| {
+        let d = p.coords - centre;
+        d.dot(&b).atan2(d.dot(&a))
+    };
     points.sort_by(|p, q| angle(p).total_cmp(&angle(q)));
     Some(points)
 }
 
 /// Volume of a closed convex body from its face loops: the pyramids from the mean of
 /// its vertices (inside or on it) to each face, whatever the loops' orientation.
-fn volume(faces: &Faces) -> Real {
+pub(crate) fn volume(faces: &Faces) -> Real {
     let count = faces.iter().map(Vec::len).sum::<usize>();
     if count == 0 {
         return 0.0;

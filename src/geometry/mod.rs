@@ -17,8 +17,12 @@
 //! - [`wall`]: polyhedron–triangle contact for wall meshes;
 //! - [`sphere`]: analytic sphere kernels;
 //! - [`cell_volumes`]: a particle's volume split exactly among the cells of a grid;
+//! - [`section`], [`axial_volumes`]: plane sections and their areas in discs and
+//!   sectors; a particle's volume in the slabs, annuli and sectors of a tube;
+//! - [`voronoi_volumes`]: a particle's volume in the Voronoi cells of given centres;
 //! - [`quadrature`]: Gauss–Legendre and tanh–sinh rules.
 
+pub mod axial_volumes;
 pub mod cell_volumes;
 mod error;
 pub mod generators;
@@ -32,11 +36,13 @@ mod polygon;
 mod polyhedron;
 pub mod quadrature;
 mod rotation;
+pub mod section;
 mod shape;
 mod spec;
 pub mod sphere;
 pub mod surfaces;
 mod trimesh;
+pub mod voronoi_volumes;
 pub mod wall;
 
 pub use error::GeometryError;

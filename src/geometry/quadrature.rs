@@ -68,6 +68,66 @@ pub fn tanh_sinh(f: &impl Fn(Real) -> Real, lo: Real, hi: Real, tolerance: Real)
     estimate
 }
 
+/// Adds to `out` the integrals over `[lo, hi]` of the `out.len()` functions that
+/// `f(x, weight, out)` adds, each times `weight`, at `x`: 5-point Gauss–Legendre
+/// between consecutive `breaks` (sorted, within `[lo, hi]`, where the functions may
+/// have kinks), each interval halved until its two halves agree with the whole to
+/// `tolerance` per unit of length (at most 20 times). Every function is evaluated at
+/// the same points, so a sum over them is integrated as one function (what
+/// partitions of a body need: pieces that add up to its whole add up to the whole's
+/// integral to round-off when the rule is exact for it). Returns the estimated
+/// error, the largest over the functions, summed over intervals.
+pub fn adaptive_gauss(
+    breaks: &[Real],
+    tolerance: Real,
+    out: &mut [Real],
+    f: &impl Fn(Real, Real, &mut [Real]),
+) -> Real {
+    let n = out.len();
+    let rule = |lo: Real, hi: Real| {
+        let (mid, half) = (0.5 * (lo + hi), 0.5 * (hi - lo));
+        let mut sum = vec![0.0; n];
+        for (x, w) in GAUSS5_NODES.iter().zip(GAUSS5_WEIGHTS) {
+            f(mid + half * x, w * half, &mut sum);
+        }
+        sum
+    };
+    let mut error = 0.0;
+    for w in breaks.windows(2).filter(|w| w[1] > w[0]) {
+        let whole = rule(w[0], w[1]);
+        error += halve(&rule, (w[0], w[1]), whole, tolerance, 0, out);
+    }
+    error
+}
+
+/// One step of [`adaptive_gauss`]: adds the integral over `span` (`whole`, its
+/// estimate) to `out`, halving while the halves disagree with it.
+fn halve(
+    rule: &impl Fn(Real, Real) -> Vec<Real>,
+    span: (Real, Real),
+    whole: Vec<Real>,
+    tolerance: Real,
+    depth: usize,
+    out: &mut [Real],
+) -> Real {
+    let (lo, hi) = span;
+    let mid = 0.5 * (lo + hi);
+    let (left, right) = (rule(lo, mid), rule(mid, hi));
+    let diff = whole
+        .iter()
+        .zip(left.iter().zip(&right))
+        .map(|(w, (l, r))| (l + r - w).abs())
+        .fold(0.0, Real::max);
+    if diff <= tolerance * (hi - lo) || depth >= 20 {
+        for (o, (l, r)) in out.iter_mut().zip(left.iter().zip(&right)) {
+            *o += l + r;
+        }
+        return diff;
+    }
+    halve(rule, (lo, mid), left, tolerance, depth + 1, out)
+        + halve(rule, (mid, hi), right, tolerance, depth + 1, out)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

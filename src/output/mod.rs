@@ -11,7 +11,8 @@
 //! - `series.csv`: particles, contacts, kinetic energy and largest speed;
 //! - `summary.json`: the run's figures;
 //! - with a `[drum]` section, the drum's files (see [`drum`]);
-//! - with a `[fluid]` section, `fluid.pvd` and `frames/fluid_*.vti`: the fluid grid's
+//! - with a `[fluid]` section, `fluid.pvd` and `frames/fluid_*.vti` (`.vtp` for cells
+//!   other than a structured grid): the fluid grid's
 //!   cells with the solid fraction, fluid and mean particle velocities, pressure
 //!   gradient and the drag the particles in each cell receive;
 //! - `checkpoint.talus` and `checkpoint.prev.talus` (when checkpoints are asked for or
@@ -306,7 +307,7 @@ impl RunOutput {
             self.walls.add(world.time, w)?;
         }
         if world.fluid.is_some() {
-            let f = format!("frames/fluid_{k:06}.vti");
+            let f = format!("frames/fluid_{k:06}.{}", vtk::fluid_extension(world));
             vtk::write_fluid(world, &self.dir.join(&f))?;
             self.fluid.add(world.time, f)?;
         }

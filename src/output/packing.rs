@@ -9,6 +9,9 @@
 //!   (`z_lower,z_upper,porosity`, heights above the tube's base), and their plots
 //!   `packing_radial.png` (against the distance from the wall in particle diameters)
 //!   and `packing_axial.png`;
+//! - `packing_cells.csv`: porosity and specific surface on the cells of a
+//!   cylindrical grid (the scene's cylindrical `[fluid]` grid, else the radial bins ×
+//!   axial slices), see [`write_porosity_map`];
 //! - `poses.csv`: `id,kind,shape,x,y,z,qw,qx,qy,qz` per particle (the body frame's
 //!   pose: centroid and principal axes), which `talus analyze` reads back;
 //! - `bed.stl`: every particle's surface in place (spheres as 320-triangle
@@ -29,7 +32,7 @@ use plotters::chart::SeriesLabelPosition;
 
 use super::plot::LineChart;
 use crate::analysis::packing::mesher::{SPHERE_LEVEL, bed_contacts, capped_particles};
-use crate::analysis::packing::{Bed, Packing};
+use crate::analysis::packing::{Bed, Packing, PorosityMap};
 use crate::geometry::Shape;
 use crate::geometry::generators::icosphere_mesh;
 use crate::geometry::mesh_io::write_stl;
@@ -126,6 +129,39 @@ fn write_profile(
     for row in rows {
         let cells: Vec<String> = row.iter().map(|x| format!("{x:.9e}")).collect();
         writeln!(out, "{}", cells.join(","))?;
+    }
+    out.flush()
+}
+
+/// Writes `packing_cells.csv`: the porosity and specific surface per cell of the
+/// map's cylindrical grid, one row per cell in the grid's flat order (annulus
+/// fastest, then slab, then sector: the order of a `[fluid]` cylindrical grid's
+/// arrays), with the cell's indices and edges (heights above the base, angles in
+/// radians from the grid frame's x axis).
+pub fn write_porosity_map(dir: &Path, map: &PorosityMap) -> io::Result<()> {
+    let grid = &map.grid;
+    let [_, _, sectors] = grid.counts();
+    let width = 2.0 * std::f64::consts::PI / sectors as Real;
+    let mut out = BufWriter::new(File::create(dir.join("packing_cells.csv"))?);
+    writeln!(
+        out,
+        "annulus,slab,sector,r_inner,r_outer,z_lower,z_upper,theta_lower,theta_upper,porosity,specific_surface"
+    )?;
+    for c in 0..grid.len() {
+        let [i, j, k] = grid.cell(c);
+        let inner = if i == 0 { 0.0 } else { grid.radii()[i - 1] };
+        let edges = [
+            inner,
+            grid.radii()[i],
+            grid.heights()[j],
+            grid.heights()[j + 1],
+            k as Real * width,
+            (k + 1) as Real * width,
+            map.porosity[c],
+            map.specific_surface[c],
+        ];
+        let edges: Vec<String> = edges.iter().map(|x| format!("{x:.9e}")).collect();
+        writeln!(out, "{i},{j},{k},{}", edges.join(","))?;
     }
     out.flush()
 }

@@ -54,13 +54,16 @@ impl Array {
     }
 }
 
-/// A polygon soup with per-cell fields, written as one `.vtp` piece.
+/// A polygon soup (or a point cloud: `vertices`) with per-cell fields, written as
+/// one `.vtp` piece.
 #[derive(Default)]
 struct PolyData {
     points: Vec<f32>,
     connectivity: Vec<i64>,
     offsets: Vec<i64>,
     cell_data: Vec<Array>,
+    /// Whether the cells are single points (VTK verts) rather than polygons.
+    vertices: bool,
 }
 
 impl PolyData {
@@ -74,6 +77,11 @@ impl PolyData {
 
     fn write(self, path: &Path) -> io::Result<()> {
         let cells = self.offsets.len();
+        let (verts, polys, section) = if self.vertices {
+            (cells, 0, "Verts")
+        } else {
+            (0, cells, "Polys")
+        };
         let points = Array::F32 {
             name: "points".into(),
             components: 3,
@@ -105,7 +113,7 @@ impl PolyData {
             r#"<?xml version="1.0"?>
 <VTKFile type="PolyData" version="1.0" byte_order="LittleEndian" header_type="UInt64">
   <PolyData>
-    <Piece NumberOfPoints="{n_points}" NumberOfVerts="0" NumberOfLines="0" NumberOfStrips="0" NumberOfPolys="{cells}">
+    <Piece NumberOfPoints="{n_points}" NumberOfVerts="{verts}" NumberOfLines="0" NumberOfStrips="0" NumberOfPolys="{polys}">
       <CellData>"#
         );
         for a in &self.cell_data {
@@ -113,10 +121,10 @@ impl PolyData {
         }
         xml.push_str("      </CellData>\n      <Points>\n");
         header(&points, &mut xml, &mut blocks);
-        xml.push_str("      </Points>\n      <Polys>\n");
+        let _ = writeln!(xml, "      </Points>\n      <{section}>");
         header(&conn, &mut xml, &mut blocks);
         header(&offs, &mut xml, &mut blocks);
-        xml.push_str("      </Polys>\n    </Piece>\n  </PolyData>\n");
+        let _ = writeln!(xml, "      </{section}>\n    </Piece>\n  </PolyData>");
         write_appended(path, &xml, blocks)
     }
 }
@@ -135,10 +143,21 @@ fn write_appended(path: &Path, xml: &str, blocks: Vec<Vec<u8>>) -> io::Result<()
     out.flush()
 }
 
-/// Writes the fluid grid of `world` as VTK ImageData (`.vti`) to `path`, with per
-/// cell: the solid fraction and the mean particle velocity of the last update, the
-/// fluid velocity and pressure gradient set, and the drag the particles in it
-/// receive at this step (N; the momentum source is its opposite).
+/// The file extension of [`write_fluid`]'s frames for the fluid of `world`:
+/// `vti` for a structured grid, `vtp` for other cells.
+pub fn fluid_extension(world: &World) -> &'static str {
+    match world.fluid.as_ref().map(|f| f.grid.as_cartesian()) {
+        Some(None) => "vtp",
+        _ => "vti",
+    }
+}
+
+/// Writes the fluid cells of `world` to `path`, with per cell: the solid fraction
+/// and the mean particle velocity of the last update, the fluid velocity and
+/// pressure gradient set, and the drag the particles in it receive at this step (N;
+/// the momentum source is its opposite). A structured grid is VTK ImageData
+/// (`.vti`); other cells are PolyData points at their centres (`.vtp`: cylindrical
+/// cells at mid-radius, mid-angle and mid-height) with the cell volume as well.
 pub fn write_fluid(world: &World, path: &Path) -> io::Result<()> {
     let Some(fluid) = &world.fluid else {
         return Ok(());
@@ -165,6 +184,24 @@ pub fn write_fluid(world: &World, path: &Path) -> io::Result<()> {
         vectors("particle_velocity", &fluid.particle_velocity),
         vectors("particle_drag", &drag),
     ];
+    let Some(grid) = grid.as_cartesian() else {
+        let mut cloud = PolyData {
+            vertices: true,
+            ..Default::default()
+        };
+        for c in 0..grid.len() {
+            cloud.add_polygon([grid.centre(c)]);
+        }
+        cloud.cell_data.extend(arrays);
+        cloud.cell_data.push(Array::F32 {
+            name: "cell_volume".into(),
+            components: 1,
+            data: (0..grid.len())
+                .map(|c| grid.cell_volume(c) as f32)
+                .collect(),
+        });
+        return cloud.write(path);
+    };
     let [nx, ny, nz] = grid.counts();
     let o = grid.centre(0) - grid.cell_size() * 0.5;
     let h = grid.cell_size();

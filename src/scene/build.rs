@@ -147,7 +147,7 @@ impl<'a> Builder<'a> {
             self.world.walls.push(wall);
         }
         if let Some(fluid) = &self.spec.fluid {
-            self.world.fluid = Some(super::fluid::build_fluid(fluid, &self.world)?);
+            self.world.fluid = Some(super::fluid::build_fluid(fluid, &self.world, self.dir)?);
         }
         let names: Vec<&String> = self.spec.shapes.keys().collect();
         let mut shape_names = vec![String::new(); self.world.body_types.len()];

@@ -3,6 +3,7 @@
 use nalgebra::Vector3;
 
 use super::Simulation;
+use super::spec::UpdateInterval;
 use crate::Real;
 use crate::world::FluidField;
 
@@ -40,7 +41,8 @@ impl Simulation {
 
     /// Splits the particles' volumes among the fluid's cells again (the solid
     /// fractions, mean particle velocities and exchange weights). The simulation
-    /// does it every `update_interval` steps; a coupled code may ask for it at its
+    /// does it every `update_interval` steps, or at each communication step
+    /// ([`Self::start_communication_step`]); a coupled code may ask for it at its
     /// own exchange.
     pub fn update_fluid(&mut self) {
         let w = &mut self.world;
@@ -68,9 +70,19 @@ impl Simulation {
         Ok(fluid.take_momentum_source())
     }
 
-    /// Starts the sums of the momentum exchange again: a coupled master does it at
-    /// the start of each communication step, so that
-    /// [`FluidField::momentum_source`] is the mean over that step.
+    /// What a coupled run does at the start of each communication step, once the
+    /// coupled code has set its fields: starts the sums of the momentum exchange
+    /// again (so that [`FluidField::momentum_source`] is the mean over the step)
+    /// and, with `update_interval = "communication"`, splits the particles' volumes
+    /// among the cells again.
+    pub fn start_communication_step(&mut self) {
+        self.restart_fluid_exchange();
+        if self.fluid_interval == Some(UpdateInterval::Communication) {
+            self.update_fluid();
+        }
+    }
+
+    /// Starts the sums of the momentum exchange again.
     pub fn restart_fluid_exchange(&mut self) {
         if let Some(fluid) = self.world.fluid.as_mut() {
             fluid.restart_exchange();

@@ -9,6 +9,7 @@
 
 mod analyses;
 mod build;
+mod csv_table;
 pub mod energy_balance;
 mod error;
 mod fluid;

@@ -3,7 +3,7 @@
 
 use std::fmt;
 
-use super::spec::SceneSpec;
+use super::spec::{SceneSpec, UpdateInterval};
 use crate::Real;
 use crate::engine::time_step::TimeStepEstimate;
 use crate::geometry::Shape;
@@ -196,22 +196,17 @@ impl Plan {
             },
         );
         if let Some(f) = &world.fluid {
-            let [nx, ny, nz] = f.grid.counts();
-            let h = f.grid.cell_size();
             line(
+                format!("fluid: {}, drag {}", f.grid.describe(), f.model.law.name()),
                 format!(
-                    "fluid: {nx} × {ny} × {nz} cells of {:.4e} × {:.4e} × {:.4e} m, drag {}",
-                    h.x,
-                    h.y,
-                    h.z,
-                    f.model.law.name()
-                ),
-                format!(
-                    "density {} kg/m³, viscosity {} Pa s, shape correction {:?}; solid fraction updated every {} steps ([fluid])",
+                    "density {} kg/m³, viscosity {} Pa s, shape correction {:?}; solid fraction updated {} ([fluid])",
                     f.model.properties.density,
                     f.model.properties.viscosity,
                     f.model.correction,
-                    spec.fluid.as_ref().map_or(0, |s| s.update_interval)
+                    match spec.fluid.as_ref().map(|s| s.update_interval) {
+                        Some(UpdateInterval::Steps(n)) => format!("every {n} steps"),
+                        _ => "at each communication step".into(),
+                    }
                 ),
             );
         }

@@ -5,6 +5,7 @@ use std::path::Path;
 
 use nalgebra::{Point3, UnitQuaternion, Vector3};
 
+use super::csv_table::CsvTable;
 use crate::Real;
 
 /// One particle's pose and velocities.
@@ -29,48 +30,25 @@ pub fn read_poses(path: &Path) -> Result<Vec<PoseRecord>, String> {
 
 /// Parses pose CSV text (errors start with the line number).
 pub fn parse_poses(text: &str) -> Result<Vec<PoseRecord>, String> {
-    let mut lines = text
-        .lines()
-        .enumerate()
-        .filter(|(_, l)| !l.trim().is_empty() && !l.trim_start().starts_with('#'));
-    let Some((_, header)) = lines.next() else {
-        return Err("1: the file is empty (expected a header x,y,z,qw,qx,qy,qz)".into());
-    };
-    let names: Vec<&str> = header.split(',').map(str::trim).collect();
-    let column = |name: &str| names.iter().position(|n| *n == name);
-    let required = ["x", "y", "z", "qw", "qx", "qy", "qz"];
+    let table = CsvTable::parse(text, "x,y,z,qw,qx,qy,qz")?;
     let mut cols = [0usize; 7];
-    for (k, name) in required.iter().enumerate() {
-        cols[k] = column(name).ok_or_else(|| format!("1: the header has no column '{name}'"))?;
+    for (c, name) in cols.iter_mut().zip(["x", "y", "z", "qw", "qx", "qy", "qz"]) {
+        *c = table.require(name)?;
     }
-    let optional = ["vx", "vy", "vz", "wx", "wy", "wz"].map(column);
+    let optional = ["vx", "vy", "vz", "wx", "wy", "wz"].map(|n| table.column(n));
     let mut out = Vec::new();
-    for (l, line) in lines {
-        let fields: Vec<&str> = line.split(',').map(str::trim).collect();
-        let value = |c: usize| -> Result<Real, String> {
-            let f = fields
-                .get(c)
-                .ok_or_else(|| format!("{}: column '{}' is missing", l + 1, names[c]))?;
-            let v: Real = f
-                .parse()
-                .map_err(|_| format!("{}: column '{}': '{f}' is not a number", l + 1, names[c]))?;
-            if v.is_finite() {
-                Ok(v)
-            } else {
-                Err(format!("{}: column '{}' is not finite", l + 1, names[c]))
-            }
-        };
+    for record in table.records() {
         let mut v = [0.0; 13];
         for k in 0..7 {
-            v[k] = value(cols[k])?;
+            v[k] = record.value(cols[k])?;
         }
         for (k, c) in optional.iter().enumerate() {
             if let Some(c) = c {
-                v[7 + k] = value(*c)?;
+                v[7 + k] = record.value(*c)?;
             }
         }
         let Some(orientation) = crate::geometry::unit_quaternion(v[3], v[4], v[5], v[6]) else {
-            return Err(format!("{}: the quaternion is zero", l + 1));
+            return Err(format!("{}: the quaternion is zero", record.line));
         };
         out.push(PoseRecord {
             position: Point3::new(v[0], v[1], v[2]),

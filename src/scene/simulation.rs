@@ -6,7 +6,7 @@ use std::ops::ControlFlow;
 use nalgebra::Vector3;
 
 use super::Scene;
-use super::spec::{FreezeSpec, SettleSpec};
+use super::spec::{FreezeSpec, SettleSpec, UpdateInterval};
 use crate::Real;
 use crate::analysis::packing::{Bed, bed_height_of};
 use crate::engine::{Backend, CpuBackend, StageTimes, StepParams, StepStats};
@@ -40,8 +40,8 @@ pub struct Simulation {
     freeze: Option<FreezeSpec>,
     /// The bed height last measured while feeding or freezing.
     pub(super) bed_height: Option<Real>,
-    /// Steps between updates of the fluid's particle shares (`[fluid]`).
-    fluid_interval: u64,
+    /// When the fluid's particle shares are computed again (`[fluid]`).
+    pub(super) fluid_interval: Option<UpdateInterval>,
 }
 
 /// Simulated time between two measurements of the bed height (while inlets feed
@@ -86,7 +86,7 @@ impl Simulation {
             bed: scene.bed,
             freeze: scene.spec.bed.as_ref().and_then(|b| b.freeze.clone()),
             bed_height: None,
-            fluid_interval: scene.spec.fluid.as_ref().map_or(0, |f| f.update_interval),
+            fluid_interval: scene.spec.fluid.as_ref().map(|f| f.update_interval),
         };
         sim.backend.world_changed(&sim.world);
         sim.insert();
@@ -242,7 +242,9 @@ impl Simulation {
         self.steps = self.steps.saturating_add(1);
         self.follow_bed(before);
         self.insert();
-        if self.fluid_interval > 0 && self.steps % self.fluid_interval == 0 {
+        if let Some(UpdateInterval::Steps(n)) = self.fluid_interval
+            && self.steps % n == 0
+        {
             self.update_fluid();
         }
         self.update_settling();

@@ -49,19 +49,44 @@ pub struct SceneSpec {
     pub fluid: Option<FluidSpec>,
 }
 
-/// `[fluid]`: the grid of a coupled CFD code, the fluid and its drag law (see
+/// `[fluid]`: the cells of a coupled CFD code, the fluid and its drag law (see
 /// [`crate::fluid`]). A coupled code sets each cell's velocity and pressure gradient
 /// and reads back the solid volume fraction, the mean particle velocity and the
 /// momentum source; without one the fluid stays as the scene gives it.
+///
+/// The cells (`grid`):
+/// - `"cartesian"` (default): `origin`, `cell` (edges) and `cells` (counts along
+///   x, y, z);
+/// - `"cylindrical"`: a tube from `base` along `axis` (default z) of `height`, with
+///   `cells = [annuli, slabs, sectors]` and either `radius` (annuli of equal width)
+///   or `radii` (each annulus's outer radius, ascending);
+/// - `"cells"`: `file`, a CSV of the coupled code's cells (header `x,y,z,volume`,
+///   one cell per line, in the order of its arrays), taken as the Voronoi cells of
+///   their centres.
 #[derive(Clone, Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct FluidSpec {
-    /// Corner of the grid (its lowest x, y, z).
-    pub origin: [Real; 3],
-    /// Cell edges along x, y, z, m.
-    pub cell: [Real; 3],
-    /// Cells along x, y, z.
-    pub cells: [usize; 3],
+    /// The kind of cells.
+    #[serde(default)]
+    pub grid: GridKind,
+    /// Cartesian: corner of the grid (its lowest x, y, z).
+    pub origin: Option<[Real; 3]>,
+    /// Cartesian: cell edges along x, y, z, m.
+    pub cell: Option<[Real; 3]>,
+    /// Cartesian: cells along x, y, z; cylindrical: annuli, slabs, sectors.
+    pub cells: Option<[usize; 3]>,
+    /// Cylindrical: centre of the tube's base.
+    pub base: Option<[Real; 3]>,
+    /// Cylindrical: the tube's axis (default z).
+    pub axis: Option<[Real; 3]>,
+    /// Cylindrical: the tube's radius (annuli of equal width).
+    pub radius: Option<Real>,
+    /// Cylindrical: each annulus's outer radius, ascending (instead of `radius`).
+    pub radii: Option<Vec<Real>>,
+    /// Cylindrical: the tube's length along its axis.
+    pub height: Option<Real>,
+    /// Given cells: the CSV file of centres and volumes (relative to the scene).
+    pub file: Option<String>,
     /// Fluid density, kg/m³.
     pub density: Real,
     /// Dynamic viscosity, Pa s.
@@ -77,15 +102,81 @@ pub struct FluidSpec {
     /// The pressure gradient in every cell at the start, Pa/m (default: hydrostatic,
     /// density × gravity).
     pub pressure_gradient: Option<[Real; 3]>,
-    /// Steps between two updates of the particles' volume per cell (the solid
-    /// fraction and the weights of the exchange), default 50: the coupling interval
-    /// of usual CFD–DEM runs, in which a particle moves a small part of a cell.
-    #[serde(default = "default_fluid_update")]
-    pub update_interval: u64,
+    /// When the particles' volume per cell (the solid fraction and the weights of
+    /// the exchange) is computed again: every so many steps (default 50: the
+    /// coupling interval of usual CFD–DEM runs, in which a particle moves a small
+    /// part of a cell), or `"communication"`: at the start of each communication
+    /// step of a coupled run (FMU, C API, zenoh), when the coupled code has just
+    /// exchanged its fields.
+    #[serde(default)]
+    pub update_interval: UpdateInterval,
 }
 
-fn default_fluid_update() -> u64 {
-    50
+/// The kinds of fluid cells (`[fluid] grid`).
+#[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum GridKind {
+    /// Axis-aligned cells of one size.
+    #[default]
+    Cartesian,
+    /// Annuli × slabs × sectors in a tube.
+    Cylindrical,
+    /// Cells a coupled code gives by centres and volumes.
+    Cells,
+}
+
+/// When the fluid's particle shares are computed again (`[fluid] update_interval`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum UpdateInterval {
+    /// Every so many DEM steps (at least 1).
+    Steps(u64),
+    /// At the start of each communication step of a coupled run.
+    Communication,
+}
+
+impl Default for UpdateInterval {
+    fn default() -> Self {
+        UpdateInterval::Steps(50)
+    }
+}
+
+impl Serialize for UpdateInterval {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        match self {
+            UpdateInterval::Steps(n) => s.serialize_u64(*n),
+            UpdateInterval::Communication => s.serialize_str("communication"),
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for UpdateInterval {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct Visitor;
+        impl serde::de::Visitor<'_> for Visitor {
+            type Value = UpdateInterval;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a number of steps or \"communication\"")
+            }
+            fn visit_i64<E: serde::de::Error>(self, v: i64) -> Result<Self::Value, E> {
+                u64::try_from(v)
+                    .map(UpdateInterval::Steps)
+                    .map_err(|_| E::custom(format!("{v} steps: must be at least 1")))
+            }
+            fn visit_u64<E: serde::de::Error>(self, v: u64) -> Result<Self::Value, E> {
+                Ok(UpdateInterval::Steps(v))
+            }
+            fn visit_str<E: serde::de::Error>(self, v: &str) -> Result<Self::Value, E> {
+                if v == "communication" {
+                    Ok(UpdateInterval::Communication)
+                } else {
+                    Err(E::custom(format!(
+                        "\"{v}\": expected a number of steps or \"communication\""
+                    )))
+                }
+            }
+        }
+        d.deserialize_any(Visitor)
+    }
 }
 
 /// `[bed]`: the tube a bed is packed in, and how the packing is analysed (see

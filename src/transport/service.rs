@@ -333,11 +333,7 @@ impl Service {
                 status: pb::Status::Ok as i32,
                 error: String::new(),
                 time: self.time(),
-                grid: Some(pb::FluidGrid {
-                    origin: Some(vec3(grid.origin().coords.as_slice())),
-                    cell: Some(vec3(grid.cell_size().as_slice())),
-                    counts: grid.counts().iter().map(|&n| n as u32).collect(),
-                }),
+                grid: Some(fluid_grid(grid)),
                 solid_fraction: self.vector("fluid.solid_fraction")?,
                 particle_velocity: self.vector("fluid.particle_velocity")?,
                 momentum_source: self.vector("fluid.momentum_source")?,
@@ -390,5 +386,22 @@ impl Service {
                 time: self.time(),
             },
         }
+    }
+}
+
+/// The message of a fluid's cells.
+fn fluid_grid(grid: &crate::fluid::FluidGrid) -> pb::FluidGrid {
+    let cartesian = grid.as_cartesian();
+    pb::FluidGrid {
+        origin: cartesian.map(|g| vec3(g.origin().coords.as_slice())),
+        cell: cartesian.map(|g| vec3(g.cell_size().as_slice())),
+        counts: cartesian.map_or(Vec::new(), |g| {
+            g.counts().iter().map(|&n| n as u32).collect()
+        }),
+        kind: grid.kind().into(),
+        centres: (0..grid.len())
+            .flat_map(|c| grid.centre(c).coords.as_slice().to_vec())
+            .collect(),
+        volumes: (0..grid.len()).map(|c| grid.cell_volume(c)).collect(),
     }
 }

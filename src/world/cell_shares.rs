@@ -7,8 +7,7 @@ use rayon::prelude::*;
 use super::{BodyType, Particles};
 use crate::Real;
 use crate::fluid::FluidGrid;
-use crate::geometry::cell_volumes::{placed_faces, polyhedron_cell_volumes, sphere_cell_volumes};
-use crate::geometry::{Pose, Shape};
+use crate::geometry::Pose;
 
 /// Per particle, the cells it reaches and its volume in each.
 ///
@@ -37,7 +36,7 @@ impl CellShares {
                     particles.position[i].coords.into(),
                     particles.orientation[i],
                 );
-                particle_shares(grid, &types[particles.body_type[i] as usize].shape, &pose)
+                grid.shares(&types[particles.body_type[i] as usize].shape, &pose)
             })
             .collect();
         let mut shares = CellShares {
@@ -112,35 +111,4 @@ impl CellShares {
     pub fn is_empty(&self) -> bool {
         self.ids.is_empty()
     }
-}
-
-/// The cells `shape` at `pose` reaches, ascending, with its volume in each.
-fn particle_shares(grid: &FluidGrid, shape: &Shape, pose: &Pose) -> Vec<(u32, Real)> {
-    let centre = pose.translation.vector.into();
-    let reach = shape.circumradius();
-    // Wholly inside one cell: no clipping.
-    if let Some(c) = grid.cell_of(&centre) {
-        let b = grid.bounds();
-        let inside = (0..3).all(|a| {
-            let k = b[a].partition_point(|&x| x <= centre[a]) - 1;
-            centre[a] - reach >= b[a][k] && centre[a] + reach <= b[a][k + 1]
-        });
-        if inside {
-            return vec![(c as u32, shape.volume())];
-        }
-    }
-    let mut out = Vec::new();
-    let mut push = |c: [usize; 3], v: Real| {
-        if v > 0.0 {
-            out.push((grid.index(c) as u32, v));
-        }
-    };
-    match shape {
-        Shape::Sphere(s) => sphere_cell_volumes(centre, s.radius, grid.bounds(), &mut push),
-        Shape::Polyhedron(p) => {
-            polyhedron_cell_volumes(placed_faces(p, pose), grid.bounds(), &mut push)
-        }
-    }
-    out.sort_by_key(|x| x.0);
-    out
 }

@@ -108,14 +108,14 @@ impl FluidField {
                 momentum[c as usize] += particles.velocity[i] * v;
             }
         }
-        let cell = self.grid.cell_volume();
-        for ((phi, u), (s, m)) in self
+        for (c, ((phi, u), (s, m))) in self
             .solid_fraction
             .iter_mut()
             .zip(&mut self.particle_velocity)
             .zip(solid.iter().zip(&momentum))
+            .enumerate()
         {
-            *phi = s / cell;
+            *phi = s / self.grid.cell_volume(c);
             *u = if *s > 0.0 { m / *s } else { Vector3::zeros() };
         }
     }

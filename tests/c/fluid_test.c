@@ -34,6 +34,20 @@ int main(int argc, char **argv) {
     CHECK(cell[2] == 0.01 && origin[0] == 0.0, "cell size and origin");
     CHECK(talus_get_fluid_grid(c, origin, NULL, counts) == TALUS_ERROR, "null cell refused");
     size_t cells = counts[0] * counts[1] * counts[2];
+    /* Every kind of cells: centres and volumes. */
+    size_t n = 0;
+    CHECK(talus_get_fluid_cell_count(c, &n) == TALUS_OK && n == cells, "cell count");
+    double centres[3 * 54], volumes[54];
+    CHECK(n == 54, "54 cells");
+    CHECK(talus_get_fluid_cells(c, n - 1, centres, volumes) == TALUS_ERROR, "wrong n refused");
+    CHECK(talus_get_fluid_cells(c, n, centres, NULL) == TALUS_ERROR, "null volumes refused");
+    CHECK(talus_get_fluid_cells(c, n, centres, volumes) == TALUS_OK, "cells");
+    /* Cell [1, 2, 3] (x fastest): centre (0.015, 0.025, 0.035), volume 1 cm3. */
+    size_t k = 1 + 3 * (2 + 3 * 3);
+    CHECK(fabs(centres[3 * k] - 0.015) < 1e-15 && fabs(centres[3 * k + 1] - 0.025) < 1e-15 &&
+              fabs(centres[3 * k + 2] - 0.035) < 1e-15,
+          "a cell's centre");
+    CHECK(fabs(volumes[k] - 1e-6) < 1e-20, "a cell's volume");
 
     double *u = malloc(3 * cells * sizeof(double));
     double *before = malloc(3 * cells * sizeof(double));

@@ -1,6 +1,7 @@
 //! The structure of a packed bed in a tube: bed height, bed-averaged porosity,
-//! radial and axial porosity profiles, coordination numbers, pellet orientations,
-//! and the figures reactor models take ([`ReactorFigures`]: specific surface and
+//! radial and axial porosity profiles (also as the cells of a cylindrical grid:
+//! [`porosity_map`]), coordination numbers, pellet orientations, and the figures
+//! reactor models take ([`ReactorFigures`]: specific surface and
 //! its radial profile, Sauter and volume-equivalent diameters, wall contacts,
 //! permeabilities).
 //!
@@ -12,7 +13,7 @@
 //! heights of the polyhedron's vertices, so there the polygon's area is a quadratic
 //! in z and Gauss–Legendre quadrature between vertex heights integrates it exactly;
 //! the part of a polygon inside a disc is exact for each z
-//! ([`super::section::polygon_disc_area`]) but not polynomial in z, so those
+//! ([`crate::geometry::section::polygon_disc_area`]) but not polynomial in z, so those
 //! integrals are adaptive (5-point Gauss–Legendre, halved until two halves agree
 //! with the whole to `1e-9` of the particle's volume per unit of its height). The
 //! estimated error of the whole region's volume is reported with the figures. A
@@ -33,18 +34,20 @@
 
 mod clipped;
 mod coordination;
+mod map;
 pub mod mesher;
 mod near;
 mod reactor;
 
-use nalgebra::{Isometry3, Point3, UnitQuaternion, Vector3};
+use nalgebra::{Isometry3, Point3, Vector3};
 use serde::Serialize;
 
 use crate::Real;
 use crate::geometry::Shape;
+use crate::geometry::axial_volumes::{AxialBody, Sectors, axis_frame};
 use crate::world::World;
-use clipped::Body;
 use coordination::coordination;
+pub use map::{PorosityMap, porosity_map};
 pub use reactor::ReactorFigures;
 use reactor::SolidShare;
 
@@ -62,11 +65,7 @@ pub struct Tube {
 impl Tube {
     /// The bed frame: world point → (x, y across the axis, z along it from the base).
     pub fn frame(&self) -> Isometry3<Real> {
-        let turn = UnitQuaternion::rotation_between(&self.axis, &Vector3::z()).unwrap_or_else(
-            // Axis along −z: half a turn about x.
-            || UnitQuaternion::from_axis_angle(&Vector3::x_axis(), std::f64::consts::PI),
-        );
-        Isometry3::from_parts((turn * -self.base.coords).into(), turn)
+        axis_frame(&self.base, &self.axis)
     }
 
     /// Height above the base, along the axis, of the top of particle `i`'s bounding
@@ -189,7 +188,7 @@ pub struct Bed {
 
 /// Bodies placed in the bed frame with the derived lengths.
 struct Placed<'a> {
-    bodies: Vec<Body<'a>>,
+    bodies: Vec<AxialBody<'a>>,
     /// Each body's surface over its volume.
     surface_ratio: Vec<Real>,
     tube: Tube,
@@ -232,7 +231,7 @@ impl<'a> Placed<'a> {
         Ok(Placed {
             bodies: kept
                 .iter()
-                .map(|&i| Body::place(world, i, &frame))
+                .map(|&i| clipped::place(world, i, &frame))
                 .collect(),
             surface_ratio: kept
                 .iter()
@@ -274,7 +273,9 @@ impl<'a> Placed<'a> {
             let last = ((hi / slice).ceil() as usize).min(slices);
             for (k, v) in solid.iter_mut().enumerate().take(last).skip(first) {
                 let z = (k as Real * slice, (k + 1) as Real * slice);
-                *v += b.clipped_volumes(z.0, z.1, &[self.tube.radius]).0[0];
+                *v += b
+                    .clipped_volumes(z.0, z.1, &[self.tube.radius], Sectors(1))
+                    .0[0];
             }
         }
         let fractions: Vec<Real> = solid.iter().map(|v| v / (self.area() * slice)).collect();
@@ -312,7 +313,7 @@ impl<'a> Placed<'a> {
         let mut inside = vec![SolidShare::default(); radii.len()];
         let mut error = 0.0;
         for (b, ratio) in self.bodies.iter().zip(&self.surface_ratio) {
-            let (v, e) = b.clipped_volumes(z0, z1, radii);
+            let (v, e) = b.clipped_volumes(z0, z1, radii, Sectors(1));
             error += e;
             let whole = b.volume();
             for (acc, x) in inside.iter_mut().zip(v) {
@@ -409,10 +410,8 @@ pub fn analyse(world: &World, bed: &Bed) -> Result<Packing, String> {
     let (fractions, bed_height) = placed.axial();
     let (z0, z1) = placed.region(bed_height, bed.options.region)?;
     let (radius, bin) = (placed.tube.radius, placed.bin);
-    // A remainder under 1 % of a bin (a radius given to a few digits: R/bin =
-    // 60.001) widens the last bin instead of making a sliver whose porosity reads 1.
-    let bins = (radius / bin - 0.01).ceil().max(1.0) as usize;
-    let radii: Vec<Real> = (1..bins).map(|k| k as Real * bin).chain([radius]).collect();
+    let radii = radial_bins(radius, bin);
+    let bins = radii.len();
     let (inside, volume_error) = placed.volumes(z0, z1, &radii);
     let height = z1 - z0;
     let mut radial = Vec::with_capacity(bins);
@@ -468,6 +467,14 @@ pub fn analyse(world: &World, bed: &Bed) -> Result<Packing, String> {
         orientation_order,
         reactor,
     })
+}
+
+/// The outer radii of the radial bins of width `bin` out to `radius`: a remainder
+/// under 1 % of a bin (a radius given to a few digits: R/bin = 60.001) widens the
+/// last bin instead of making a sliver whose porosity reads 1.
+fn radial_bins(radius: Real, bin: Real) -> Vec<Real> {
+    let bins = (radius / bin - 0.01).ceil().max(1.0) as usize;
+    (1..bins).map(|k| k as Real * bin).chain([radius]).collect()
 }
 
 /// Histogram of |cos θ| (10 bins) and the order parameter over polyhedral particles.

@@ -4,9 +4,9 @@
 use std::path::Path;
 
 use anyhow::{Context, Result, anyhow, bail};
-use talus::analysis::packing::{Bed, analyse};
+use talus::analysis::packing::{Bed, analyse, porosity_map};
 use talus::output::packing::{
-    read_poses, write_bed_stl, write_capped_bed, write_packing, write_poses,
+    read_poses, write_bed_stl, write_capped_bed, write_packing, write_porosity_map, write_poses,
 };
 use talus::scene::Scene;
 use talus::world::World;
@@ -20,6 +20,8 @@ pub fn write_bed_files(scene: &Scene, bed: &Bed, world: &World, dir: &Path) -> R
     write_capped_bed(dir, world, bed)?;
     let packing = analyse(world, bed).map_err(|e| anyhow!("packing analysis: {e}"))?;
     write_packing(dir, &packing)?;
+    let map = porosity_map(world, bed).map_err(|e| anyhow!("porosity map: {e}"))?;
+    write_porosity_map(dir, &map)?;
     println!(
         "bed: {} particles, height {:.4e} m, porosity {:.4} over {:.4e}–{:.4e} m (N = {:.2}), \
          mean coordination {:.2}; packing.json in {}",

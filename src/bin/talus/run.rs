@@ -8,12 +8,13 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
-use anyhow::{Context, Result};
+use anyhow::{Context, Result, bail};
 use indicatif::{ProgressBar, ProgressStyle};
 use talus::Real;
 use talus::checkpoint::{Checkpoint, RunProgress};
 use talus::output::{RunOutput, StageSummary, Summary, WallSummary};
 use talus::scene::energy_balance::EnergyBalance;
+use talus::scene::spec::UpdateInterval;
 use talus::scene::{Scene, Simulation};
 
 use crate::checkpoint;
@@ -63,6 +64,15 @@ pub fn run(path: Option<&Path>, options: RunOptions) -> Result<()> {
             (scene, dir, None)
         }
     };
+    if let Some(f) = &scene.spec.fluid
+        && f.update_interval == UpdateInterval::Communication
+    {
+        bail!(
+            "{}: [fluid] update_interval = \"communication\" needs a coupled run (FMU, C API, \
+             zenoh), which has communication steps; talus run has none: give a number of steps",
+            scene.file.display()
+        );
+    }
     let threads = match (options.threads, scene.spec.simulation.threads) {
         (0, 0) => std::thread::available_parallelism().map_or(1, |n| n.get()),
         (0, t) | (t, _) => t,
