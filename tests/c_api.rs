@@ -152,4 +152,24 @@ fn a_c_program_exchanges_the_fluid_fields_through_the_c_api() {
         .filter_map(|w| w.parse().ok())
         .collect();
     assert_eq!(numbers, vec![s[0], s[1], s[2], phi], "{line}");
+    // Per particle: the sums the C program printed, from the Rust component.
+    let (ids, fluid) = c.particle_fluid().unwrap();
+    let expected = format!(
+        "particles {} drag {:?} slip {:?} voidage {:?} ids {}",
+        ids.len(),
+        fluid.iter().map(|f| f.drag.z).sum::<f64>(),
+        fluid.iter().map(|f| f.slip.z).sum::<f64>(),
+        fluid.iter().map(|f| f.voidage).sum::<f64>(),
+        ids.iter().sum::<u64>()
+    );
+    let line = printed
+        .lines()
+        .find(|l| l.starts_with("particles"))
+        .unwrap();
+    let parse = |l: &str| -> Vec<f64> {
+        l.split_whitespace()
+            .filter_map(|w| w.parse().ok())
+            .collect()
+    };
+    assert_eq!(parse(line), parse(&expected), "{line}");
 }

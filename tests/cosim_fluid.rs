@@ -186,6 +186,18 @@ fn hands_over(mut c: Component, scene: Scene, cells: usize, each_communication: 
             .collect();
         assert_eq!(vector(&c, "fluid.particle_velocity"), mean);
     }
+    // Each particle's drag, slip and voidage: the simulation's, bit for bit; the
+    // upward gas lifts the bed and each particle reads a voidage in (0, 1].
+    let (ids, each) = c.particle_fluid().unwrap();
+    let world = sim.world();
+    let fluid = sim.fluid().unwrap();
+    assert_eq!(ids, world.particles.id[..world.particles.owned()]);
+    for (i, f) in each.iter().enumerate() {
+        assert_eq!(*f, fluid.at_particle(&world.particles, i));
+        assert!(f.voidage > 0.0 && f.voidage <= 1.0, "{f:?}");
+    }
+    let lift: Real = each.iter().map(|f| f.drag.z).sum();
+    assert!(lift > 0.0, "{lift}");
     // The gas lifts: the particles push down on it, and the solid fills cells.
     let source = vector(&c, "fluid.momentum_source");
     let down: Real = source.chunks_exact(3).map(|f| f[2]).sum();

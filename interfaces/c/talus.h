@@ -209,6 +209,27 @@ int talus_get_fluid_cells(struct talus_component *handle,
                           double *centres,
                           double *volumes);
 
+// The number of particles whose fluid `talus_get_particle_fluid` gives (scenes
+// with `[fluid]`; it changes as inlets add particles).
+//
+// # Safety
+// `handle` is a live component; `count` points to writable memory.
+int talus_get_particle_count(struct talus_component *handle, size_t *count);
+
+// What the fluid does to each of the `n` particles (`talus_get_particle_count`):
+// its id, the drag of the last force evaluation (x y z, N), the slip (the fluid's
+// velocity at the particle less its own, x y z, m/s) and the local void fraction.
+// `ids` and `voidage` have room for `n` values, `drag` and `slip` for `3 n`.
+//
+// # Safety
+// `handle` is a live component; the arrays have room as stated.
+int talus_get_particle_fluid(struct talus_component *handle,
+                             size_t n,
+                             uint64_t *ids,
+                             double *drag,
+                             double *slip,
+                             double *voidage);
+
 // Reads the `n` values of the real variable called `name`.
 //
 // # Safety

@@ -126,9 +126,10 @@ class Client:
                 m.velocity.angular.x, m.velocity.angular.y, m.velocity.angular.z = w
         return self._query("step", req, self.pb.StepReply, check)
 
-    def fluid(self):
-        """The fluid's grid and per-cell fields (FluidReply)."""
-        return self._query("fluid", self.pb.FluidRequest(), self.pb.FluidReply)
+    def fluid(self, particles=False):
+        """The fluid's grid and per-cell fields (FluidReply); with `particles`, also
+        each particle's id, drag, slip and local voidage."""
+        return self._query("fluid", self.pb.FluidRequest(particles=particles), self.pb.FluidReply)
 
     def save(self):
         return self._query("state", self.pb.StateRequest(save=True), self.pb.StateReply).state

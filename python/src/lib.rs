@@ -162,6 +162,15 @@ impl Scene {
         Ok(f(sim.world()))
     }
 
+    /// What the fluid does to each particle, in the order of the particle arrays.
+    fn particle_fluid(&self) -> PyResult<Vec<talus::world::ParticleFluid>> {
+        self.read(|c| {
+            c.particle_fluid()
+                .map(|(_, each)| each)
+                .map_err(|e| e.to_string())
+        })
+    }
+
     /// One value per owned particle, `width` reals each, as an `(n, width)` array.
     fn per_particle<'py>(
         &self,
@@ -448,6 +457,39 @@ impl Scene {
             let q = w.particles.orientation[i];
             out.extend_from_slice(&[q.w, q.i, q.j, q.k]);
         })
+    }
+
+    /// With a `[fluid]`: each particle's drag of the last force evaluation, `(n, 3)`,
+    /// N.
+    #[getter]
+    fn fluid_drag<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<Real>>> {
+        let each = self.particle_fluid()?;
+        rows3(
+            py,
+            each.iter().flat_map(|f| f.drag.iter().copied()).collect(),
+        )
+    }
+
+    /// With a `[fluid]`: the fluid's velocity at each particle less its own, `(n, 3)`,
+    /// m/s.
+    #[getter]
+    fn fluid_slip<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<Real>>> {
+        let each = self.particle_fluid()?;
+        rows3(
+            py,
+            each.iter().flat_map(|f| f.slip.iter().copied()).collect(),
+        )
+    }
+
+    /// With a `[fluid]`: the fluid's volume fraction at each particle, `(n,)`.
+    #[getter]
+    fn fluid_voidage<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<Real>>> {
+        let each = self.particle_fluid()?;
+        Ok(each
+            .iter()
+            .map(|f| f.voidage)
+            .collect::<Vec<_>>()
+            .into_pyarray(py))
     }
 
     /// The whole state as bytes (checksummed; restores on a scene of the same file).

@@ -13,7 +13,7 @@ use crate::Real;
 use crate::output::RunOutput;
 use crate::scene::energy_balance::EnergyBalance;
 use crate::scene::{Scene, SimState, Simulation};
-use crate::world::{DriveInput, WallMotion};
+use crate::world::{DriveInput, ParticleFluid, WallMotion};
 
 /// Mode of the life cycle.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -548,6 +548,22 @@ impl Component {
             .as_ref()
             .map(|f| &f.grid)
             .ok_or(CosimError::NoFluid)
+    }
+
+    /// Each particle's id and what the fluid does to it (drag of the last force
+    /// evaluation, slip, local voidage: [`ParticleFluid`]), in the simulation's
+    /// order; before initialisation the scene's particles at rest in the start
+    /// fields (no drag yet). Particles come and go, so this crosses the faces as
+    /// whole lists (C API, zenoh), not as variables.
+    pub fn particle_fluid(&self) -> Result<(Vec<u64>, Vec<ParticleFluid>), CosimError> {
+        let world = self.sim.as_ref().map_or(&self.scene.world, |s| s.world());
+        let fluid = world.fluid.as_ref().ok_or(CosimError::NoFluid)?;
+        let p = &world.particles;
+        let n = p.owned();
+        Ok((
+            p.id[..n].to_vec(),
+            (0..n).map(|i| fluid.at_particle(p, i)).collect(),
+        ))
     }
 
     /// Index of the wall called `name`.

@@ -530,6 +530,62 @@ pub unsafe extern "C" fn talus_get_fluid_cells(
     })
 }
 
+/// The number of particles whose fluid `talus_get_particle_fluid` gives (scenes
+/// with `[fluid]`; it changes as inlets add particles).
+///
+/// # Safety
+/// `handle` is a live component; `count` points to writable memory.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn talus_get_particle_count(
+    handle: *mut TalusComponent,
+    count: *mut usize,
+) -> c_int {
+    with(handle, |h| {
+        let (ids, _) = h.component.particle_fluid().map_err(|e| e.to_string())?;
+        unsafe { slice_mut(count, 1, "count") }?[0] = ids.len();
+        Ok(())
+    })
+}
+
+/// What the fluid does to each of the `n` particles (`talus_get_particle_count`):
+/// its id, the drag of the last force evaluation (x y z, N), the slip (the fluid's
+/// velocity at the particle less its own, x y z, m/s) and the local void fraction.
+/// `ids` and `voidage` have room for `n` values, `drag` and `slip` for `3 n`.
+///
+/// # Safety
+/// `handle` is a live component; the arrays have room as stated.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn talus_get_particle_fluid(
+    handle: *mut TalusComponent,
+    n: usize,
+    ids: *mut u64,
+    drag: *mut f64,
+    slip: *mut f64,
+    voidage: *mut f64,
+) -> c_int {
+    with(handle, |h| {
+        let (id, fluid) = h.component.particle_fluid().map_err(|e| e.to_string())?;
+        if n != id.len() {
+            return Err(format!("n is {n}, there are {} particles", id.len()));
+        }
+        let (i, d, s, v) = unsafe {
+            (
+                slice_mut(ids, n, "ids")?,
+                slice_mut(drag, 3 * n, "drag")?,
+                slice_mut(slip, 3 * n, "slip")?,
+                slice_mut(voidage, n, "voidage")?,
+            )
+        };
+        i.copy_from_slice(&id);
+        for (k, f) in fluid.iter().enumerate() {
+            d[3 * k..3 * k + 3].copy_from_slice(f.drag.as_slice());
+            s[3 * k..3 * k + 3].copy_from_slice(f.slip.as_slice());
+            v[k] = f.voidage;
+        }
+        Ok(())
+    })
+}
+
 /// Reads the `n` values of the real variable called `name`.
 ///
 /// # Safety

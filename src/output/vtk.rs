@@ -267,15 +267,11 @@ pub fn write_particles(world: &World, path: &Path) -> io::Result<()> {
             omega.extend(w.iter().map(|&x| x as f32));
         }
         if let Some(fluid) = &world.fluid {
-            let f = fluid.exchange.drag.get(i).copied().unwrap_or_default();
-            // Outside the grid: no fluid, no slip.
-            let (u, e) = fluid
-                .local(i, p.id[i], &p.position[i])
-                .map_or((p.velocity[i], 1.0), |l| (l.velocity, l.voidage));
+            let f = fluid.at_particle(p, i);
             for _ in 0..faces {
-                drag.extend(f.iter().map(|&x| x as f32));
-                slip.extend((u - p.velocity[i]).iter().map(|&x| x as f32));
-                voidage.push(e as f32);
+                drag.extend(f.drag.iter().map(|&x| x as f32));
+                slip.extend(f.slip.iter().map(|&x| x as f32));
+                voidage.push(f.voidage as f32);
             }
         }
     }

@@ -323,13 +323,26 @@ impl Service {
         }
     }
 
-    /// `<key>/fluid`: the grid and the per-cell fields of a coupled fluid.
+    /// `<key>/fluid`: the grid and the per-cell fields of a coupled fluid (and, when
+    /// asked, what the fluid does to each particle).
     pub fn fluid(&self, payload: &[u8]) -> pb::FluidReply {
         let result = (|| {
-            pb::FluidRequest::decode(payload)
+            let request = pb::FluidRequest::decode(payload)
                 .map_err(|e| format!("malformed FluidRequest: {e}"))?;
             let grid = self.component.fluid_grid().map_err(|e| e.to_string())?;
+            let (ids, particles) = if request.particles {
+                self.component.particle_fluid().map_err(|e| e.to_string())?
+            } else {
+                (Vec::new(), Vec::new())
+            };
+            let flat = |f: fn(&crate::world::ParticleFluid) -> [Real; 3]| {
+                particles.iter().flat_map(f).collect::<Vec<_>>()
+            };
             Ok::<_, String>(pb::FluidReply {
+                particle_ids: ids,
+                particle_drag: flat(|p| p.drag.into()),
+                particle_slip: flat(|p| p.slip.into()),
+                particle_voidage: particles.iter().map(|p| p.voidage).collect(),
                 status: pb::Status::Ok as i32,
                 error: String::new(),
                 time: self.time(),

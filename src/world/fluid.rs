@@ -70,7 +70,33 @@ pub struct LocalFluid {
     pub pressure_gradient: Vector3<Real>,
 }
 
+/// What the fluid does to one particle: the drag of the last force evaluation, the
+/// slip (the fluid's velocity at the particle less the particle's) and the local
+/// void fraction; outside the grid no drag, no slip and a voidage of 1.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ParticleFluid {
+    /// Drag, N.
+    pub drag: Vector3<Real>,
+    /// Fluid velocity at the particle less its own, m/s.
+    pub slip: Vector3<Real>,
+    /// Fluid volume fraction at the particle.
+    pub voidage: Real,
+}
+
 impl FluidField {
+    /// The fluid at owned particle `i` of `particles` ([`ParticleFluid`]).
+    pub fn at_particle(&self, particles: &Particles, i: usize) -> ParticleFluid {
+        let v = particles.velocity[i];
+        let (u, voidage) = self
+            .local(i, particles.id[i], &particles.position[i])
+            .map_or((v, 1.0), |l| (l.velocity, l.voidage));
+        ParticleFluid {
+            drag: self.exchange.drag.get(i).copied().unwrap_or_default(),
+            slip: u - v,
+            voidage,
+        }
+    }
+
     /// A field on `grid` with uniform inputs and no particles yet.
     pub fn new(
         grid: FluidGrid,

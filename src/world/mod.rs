@@ -11,7 +11,7 @@ mod walls;
 use nalgebra::Vector3;
 
 pub use cell_shares::CellShares;
-pub use fluid::{DragModel, FluidField, LocalFluid, MomentumExchange};
+pub use fluid::{DragModel, FluidField, LocalFluid, MomentumExchange, ParticleFluid};
 pub use inlet::{Inlet, PLACEMENT_ATTEMPTS, is_free, random_orientation};
 pub use motion::{DriveInput, MotionKey, WallMotion, WallVelocity, advance_pose};
 pub use particles::Particles;

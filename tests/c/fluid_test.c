@@ -3,6 +3,7 @@
  * Usage: fluid_test SCENE. Prints the outputs after two steps as
  * "source SX SY SZ solid S" (%.17g) and "ok", and exits 0 when every check passes. */
 #include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -86,6 +87,32 @@ int main(int argc, char **argv) {
     }
     printf("source %.17g %.17g %.17g solid %.17g\n", s[0], s[1], s[2], phi);
     CHECK(s[2] < 0.0, "the particles take momentum from the gas");
+
+    /* Per particle: ids, drag, slip, voidage; sums printed for the Rust side. */
+    size_t np = 0;
+    CHECK(talus_get_particle_count(c, &np) == TALUS_OK && np > 0, "particle count");
+    uint64_t *ids = malloc(np * sizeof(uint64_t));
+    double *drag = malloc(3 * np * sizeof(double)), *slip = malloc(3 * np * sizeof(double));
+    double *voidage = malloc(np * sizeof(double));
+    CHECK(talus_get_particle_fluid(c, np + 1, ids, drag, slip, voidage) == TALUS_ERROR,
+          "wrong n refused");
+    CHECK(talus_get_particle_fluid(c, np, ids, NULL, slip, voidage) == TALUS_ERROR,
+          "null drag refused");
+    CHECK(talus_get_particle_fluid(c, np, ids, drag, slip, voidage) == TALUS_OK, "particles");
+    double d = 0, e = 0, w = 0;
+    uint64_t id_sum = 0;
+    for (size_t i = 0; i < np; ++i) {
+        d += drag[3 * i + 2];
+        w += slip[3 * i + 2];
+        e += voidage[i];
+        id_sum += ids[i];
+    }
+    printf("particles %zu drag %.17g slip %.17g voidage %.17g ids %llu\n", np, d, w, e,
+           (unsigned long long)id_sum);
+    free(ids);
+    free(drag);
+    free(slip);
+    free(voidage);
 
     talus_free(c);
     free(u);

@@ -1,7 +1,7 @@
 """The Python module `talus` (PyO3, built into the test venv by scripts/test.sh):
 the same numbers as the native C API bit for bit, misuse raised as TalusError with
 the scene left as it was, saved states continuing bit for bit, particle arrays, and
-runs to an end with a progress bar."""
+runs to an end with a progress bar, each particle's fluid."""
 import ctypes
 import struct
 
@@ -154,6 +154,22 @@ def test_particle_and_wall_arrays_describe_the_bed():
     forces, torques = s.wall_forces()
     assert forces.shape == torques.shape == (1, 3)
     assert bits(forces[0]) == bits(s.wall_force(0)[0])
+
+
+def test_each_particles_fluid_matches_the_flow_it_sits_in():
+    # The fluid column at its start flow (2 m/s upward everywhere): each particle's
+    # slip plus its velocity is that flow; the drag lifts; the voidage is a fraction.
+    s = talus.Scene(str(SCENES["fluid"]))
+    s.initialize(0.0)
+    s.step(5e-4)
+    drag, slip, voidage, v = s.fluid_drag, s.fluid_slip, s.fluid_voidage, s.velocities
+    n = s.particle_count
+    assert drag.shape == slip.shape == (n, 3) and voidage.shape == (n,)
+    assert np.allclose(slip + v, [0.0, 0.0, 2.0], rtol=0, atol=1e-12)
+    assert drag[:, 2].sum() > 0.0
+    assert np.all((voidage > 0.0) & (voidage <= 1.0))
+    with pytest.raises(talus.TalusError, match="no \\[fluid\\] section"):
+        spun_drum().fluid_drag
 
 
 class Recorder:

@@ -218,6 +218,21 @@ def test_the_fluid_fields_over_zenoh_equal_the_c_apis(tmp_path, proto_dir):
                                           ctypes.c_size_t(size)) == 0
                 assert list(getattr(fields, name)) == list(out), name
             assert sum(fields.momentum_source[2::3]) < 0.0
+            assert len(fields.particle_ids) == 0, "per particle only when asked"
+            # Per particle: the same bits as the C API's.
+            each = client.fluid(particles=True)
+            n = ctypes.c_size_t()
+            assert lib.talus_get_particle_count(handle, ctypes.byref(n)) == 0
+            n = n.value
+            ids, voidage = (ctypes.c_uint64 * n)(), (ctypes.c_double * n)()
+            drag, slip = (ctypes.c_double * (3 * n))(), (ctypes.c_double * (3 * n))()
+            assert lib.talus_get_particle_fluid(handle, ctypes.c_size_t(n), ids, drag, slip,
+                                                voidage) == 0
+            assert n > 50 and list(each.particle_ids) == list(ids)
+            assert list(each.particle_drag) == list(drag)
+            assert list(each.particle_slip) == list(slip)
+            assert list(each.particle_voidage) == list(voidage)
+            assert all(0.0 < e <= 1.0 for e in voidage)
             with pytest.raises(TalusError, match="162"):
                 client.step(t, h, fluid_velocity=[1.0, 2.0])
             assert client.fluid().time == t
