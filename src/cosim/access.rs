@@ -126,7 +126,7 @@ impl Component {
             Role::WallForceEnd(w) => sim.map_or(0.0, |s| s.world().walls[w].force[k]),
             Role::WallTorqueEnd(w) => sim.map_or(0.0, |s| s.world().walls[w].torque[k]),
             Role::WallVertices(w) => {
-                let wall = sim.map_or(&self.scene.world.walls[w], |s| &s.world().walls[w]);
+                let wall = &self.world().walls[w];
                 (wall.pose * wall.vertices[k / 3])[k % 3]
             }
             Role::WallFacetForces(w) => {

@@ -13,7 +13,7 @@ use crate::Real;
 use crate::output::RunOutput;
 use crate::scene::energy_balance::EnergyBalance;
 use crate::scene::{Scene, SimState, Simulation};
-use crate::world::{DriveInput, ParticleFluid, WallMotion};
+use crate::world::{DriveInput, ParticleFluid, WallMotion, World};
 
 /// Mode of the life cycle.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -556,7 +556,7 @@ impl Component {
     /// fields (no drag yet). Particles come and go, so this crosses the faces as
     /// whole lists (C API, zenoh), not as variables.
     pub fn particle_fluid(&self) -> Result<(Vec<u64>, Vec<ParticleFluid>), CosimError> {
-        let world = self.sim.as_ref().map_or(&self.scene.world, |s| s.world());
+        let world = self.world();
         let fluid = world.fluid.as_ref().ok_or(CosimError::NoFluid)?;
         let p = &world.particles;
         let n = p.owned();
@@ -564,6 +564,11 @@ impl Component {
             p.id[..n].to_vec(),
             (0..n).map(|i| fluid.at_particle(p, i)).collect(),
         ))
+    }
+
+    /// The simulation's world once it exists, the scene's at time 0 before.
+    pub fn world(&self) -> &World {
+        self.sim.as_ref().map_or(&self.scene.world, |s| s.world())
     }
 
     /// Index of the wall called `name`.

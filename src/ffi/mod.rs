@@ -541,8 +541,8 @@ pub unsafe extern "C" fn talus_get_particle_count(
     count: *mut usize,
 ) -> c_int {
     with(handle, |h| {
-        let (ids, _) = h.component.particle_fluid().map_err(|e| e.to_string())?;
-        unsafe { slice_mut(count, 1, "count") }?[0] = ids.len();
+        h.component.fluid_grid().map_err(|e| e.to_string())?;
+        unsafe { slice_mut(count, 1, "count") }?[0] = h.component.world().particles.owned();
         Ok(())
     })
 }

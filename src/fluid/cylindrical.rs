@@ -26,12 +26,11 @@ use crate::geometry::{Pose, Shape};
 /// `2π k / n … 2π (k + 1) / n` from the frame's x axis ([`axis_frame`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct CylindricalGrid {
-    base: Point3<Real>,
-    axis: Vector3<Real>,
+    /// World → tube frame.
+    frame: Isometry3<Real>,
     radii: Vec<Real>,
     heights: Vec<Real>,
     sectors: usize,
-    frame: Isometry3<Real>,
 }
 
 impl CylindricalGrid {
@@ -66,11 +65,8 @@ impl CylindricalGrid {
         if counts.contains(&0) || counts.iter().product::<usize>() > MAX_CELLS {
             return Err(GridError::Counts(counts));
         }
-        let axis = axis / length;
         Ok(CylindricalGrid {
-            frame: axis_frame(&base, &axis),
-            base,
-            axis,
+            frame: axis_frame(&base, &(axis / length)),
             heights: (0..=axial)
                 .map(|j| height * j as Real / axial as Real)
                 .collect(),
@@ -94,16 +90,6 @@ impl CylindricalGrid {
         [self.radii.len(), self.heights.len() - 1, self.sectors]
     }
 
-    /// The centre of the tube's base.
-    pub fn base(&self) -> Point3<Real> {
-        self.base
-    }
-
-    /// The tube's axis (unit).
-    pub fn axis(&self) -> Vector3<Real> {
-        self.axis
-    }
-
     /// Outer radius of each annulus.
     pub fn radii(&self) -> &[Real] {
         &self.radii
@@ -112,11 +98,6 @@ impl CylindricalGrid {
     /// Slab boundaries, from the base along the axis.
     pub fn heights(&self) -> &[Real] {
         &self.heights
-    }
-
-    /// World → tube frame.
-    pub fn frame(&self) -> &Isometry3<Real> {
-        &self.frame
     }
 
     /// Annulus, slab and sector of the cell of flat index `n`.
@@ -165,8 +146,7 @@ impl CylindricalGrid {
         if i == self.radii.len() || j == 0 || j == self.heights.len() {
             return None;
         }
-        let width = 2.0 * PI / self.sectors as Real;
-        let k = ((q.y.atan2(q.x).rem_euclid(2.0 * PI) / width) as usize).min(self.sectors - 1);
+        let k = Sectors(self.sectors).containing(q.x, q.y);
         Some(self.index([i, j - 1, k]))
     }
 

@@ -105,11 +105,6 @@ impl GivenCells {
         self.centres[c]
     }
 
-    /// The centres, in the cells' order.
-    pub fn centres(&self) -> &[Point3<Real>] {
-        &self.centres
-    }
-
     /// The cell whose centre is nearest to `p`.
     pub fn cell_of(&self, p: &Point3<Real>) -> usize {
         self.tree

@@ -77,6 +77,13 @@ impl Sectors {
         (at(k), at(k + 1))
     }
 
+    /// The sector holding the point `(x, y)` (angles measured from +x, the last
+    /// sector taking what round-off puts at the full turn).
+    pub fn containing(self, x: Real, y: Real) -> usize {
+        let width = 2.0 * PI / self.0 as Real;
+        ((y.atan2(x).rem_euclid(2.0 * PI) / width) as usize).min(self.0 - 1)
+    }
+
     /// Directions of the rays bounding the sectors `which` (none for one sector).
     fn rays(self, which: &[usize]) -> Vec<[Real; 2]> {
         if self.0 < 2 {

@@ -7,7 +7,7 @@
 
 use rayon::prelude::*;
 
-use super::{Bed, Placed};
+use super::{Bed, Packing};
 use crate::Real;
 use crate::fluid::{CylindricalGrid, FluidGrid};
 use crate::geometry::Pose;
@@ -29,11 +29,11 @@ pub struct PorosityMap {
 }
 
 /// The map of the bed in `world` on the cylindrical `[fluid]` grid of `world`, or
-/// on the analysis's bins and slices.
-pub fn porosity_map(world: &World, bed: &Bed) -> Result<PorosityMap, String> {
+/// on the radial bins and axial slices of `packing` (the analysis of that bed).
+pub fn porosity_map(world: &World, bed: &Bed, packing: &Packing) -> Result<PorosityMap, String> {
     let grid = match world.fluid.as_ref().map(|f| &f.grid) {
         Some(FluidGrid::Cylindrical(g)) => g.clone(),
-        _ => default_grid(world, bed)?,
+        _ => default_grid(bed, packing)?,
     };
     let ratio: Vec<Real> = world
         .body_types
@@ -65,22 +65,16 @@ pub fn porosity_map(world: &World, bed: &Bed) -> Result<PorosityMap, String> {
     })
 }
 
-/// The analysis's radial bins × axial slices from the base to the top of the
-/// highest particle, one sector.
-fn default_grid(world: &World, bed: &Bed) -> Result<CylindricalGrid, String> {
-    let placed = Placed::new(world, bed, |_| true)?;
-    let top = placed
-        .bodies
-        .iter()
-        .map(|b| b.z_range().1)
-        .fold(0.0, Real::max);
-    let slices = (top / placed.slice).ceil().max(1.0) as usize;
+/// The radial bins × axial slices of `packing` (from the base to the top of the
+/// highest particle), one sector.
+fn default_grid(bed: &Bed, packing: &Packing) -> Result<CylindricalGrid, String> {
+    let height = packing.axial.last().map_or(0.0, |s| s.z_upper);
     CylindricalGrid::new(
-        placed.tube.base,
-        placed.tube.axis,
-        super::radial_bins(placed.tube.radius, placed.bin),
-        slices as Real * placed.slice,
-        slices,
+        bed.tube.base,
+        bed.tube.axis,
+        packing.radial.iter().map(|b| b.r_outer).collect(),
+        height,
+        packing.axial.len(),
         1,
     )
     .map_err(|e| e.to_string())

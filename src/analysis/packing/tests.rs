@@ -431,7 +431,7 @@ fn the_porosity_map_holds_both_profiles_and_takes_a_cylindrical_fluid_grid() {
         options,
     };
     let p = analyse(&world, &bed).unwrap();
-    let map = porosity_map(&world, &bed).unwrap();
+    let map = porosity_map(&world, &bed, &p).unwrap();
     let [annuli, slabs, sectors] = map.grid.counts();
     assert_eq!((annuli, slabs, sectors), (20, p.axial.len(), 1));
     let volume = |c: usize| map.grid.cell_volume(c);
@@ -490,7 +490,7 @@ fn the_porosity_map_holds_both_profiles_and_takes_a_cylindrical_fluid_grid() {
         Vector3::zeros(),
         Vector3::zeros(),
     ));
-    let map = porosity_map(&world, &bed).unwrap();
+    let map = porosity_map(&world, &bed, &p).unwrap();
     assert_eq!(map.grid.counts(), [4, 8, 6]);
     let v: Real = (0..map.grid.len())
         .map(|c| (1.0 - map.porosity[c]) * map.grid.cell_volume(c))

@@ -20,7 +20,7 @@ pub fn write_bed_files(scene: &Scene, bed: &Bed, world: &World, dir: &Path) -> R
     write_capped_bed(dir, world, bed)?;
     let packing = analyse(world, bed).map_err(|e| anyhow!("packing analysis: {e}"))?;
     write_packing(dir, &packing)?;
-    let map = porosity_map(world, bed).map_err(|e| anyhow!("porosity map: {e}"))?;
+    let map = porosity_map(world, bed, &packing).map_err(|e| anyhow!("porosity map: {e}"))?;
     write_porosity_map(dir, &map)?;
     println!(
         "bed: {} particles, height {:.4e} m, porosity {:.4} over {:.4e}–{:.4e} m (N = {:.2}), \
