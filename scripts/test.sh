@@ -27,3 +27,4 @@ rm -rf target/wheels
 .venv/bin/pip install --quiet --force-reinstall --no-deps target/wheels/talus-*-abi3-*.whl
 echo "== Python tests (FMUs under fmpy, the zenoh client, the talus module)"
 .venv/bin/python -m pytest tests/python -q
+echo "== disk taken by the build: $(du -sh target | cut -f1) in target/"

@@ -19,8 +19,8 @@ def swirl(phase):
 
 
 @pytest.mark.parametrize("version", [2, 3])
-def test_the_fluid_fields_cross_the_fmu_as_through_the_c_api(fmus, library, version):
-    md, unzipped, s = slave(fmus[("fluid", version)], version)
+def test_the_fluid_fields_cross_the_fmu_as_through_the_c_api(fmus, library, version, tmp_path):
+    md, unzipped, s = slave(fmus[("fluid", version)], version, tmp_path / "fmu")
     by_name = {v.name: v.valueReference for v in md.modelVariables}
     start(version, s, Log())
     lib = ctypes.CDLL(str(library))

@@ -59,9 +59,11 @@ def test_drum_torque_follows_the_rotation_input(fmus, version):
     assert backward > 1e-4, tau
 
 
-def slave(fmu_path, version, name="talus", logger=None):
+def slave(fmu_path, version, unzipdir, name="talus", logger=None):
+    """An FMU slave unzipped into `unzipdir` (a test's tmp_path: pytest removes it with
+    its old runs, where fmpy's own temporary directory would stay behind)."""
     md = read_model_description(str(fmu_path))
-    unzipped = extract(str(fmu_path))
+    unzipped = extract(str(fmu_path), unzipdir=str(unzipdir))
     cls = FMU2Slave if version == 2 else FMU3Slave
     token = md.guid
     s = cls(guid=token, unzipDirectory=unzipped, modelIdentifier=md.coSimulation.modelIdentifier,
@@ -127,8 +129,8 @@ def outputs(s, version, vr):
 
 
 @pytest.mark.parametrize("version", [2, 3])
-def test_rollback_and_serialised_states_give_identical_outputs(fmus, version):
-    md, unzipped, s = slave(fmus[("drum", version)], version)
+def test_rollback_and_serialised_states_give_identical_outputs(fmus, version, tmp_path):
+    md, unzipped, s = slave(fmus[("drum", version)], version, tmp_path / "first")
     log = Log()
     start(version, s, log)
     spin, out = drum_io(md, version)
@@ -150,7 +152,7 @@ def test_rollback_and_serialised_states_give_identical_outputs(fmus, version):
     s.freeInstance()
 
     # Bytes into a new instance.
-    md, unzipped2, s2 = slave(fmus[("drum", version)], version, name="second")
+    md, unzipped2, s2 = slave(fmus[("drum", version)], version, tmp_path / "second", name="second")
     start(version, s2, Log())
     restored = s2.deSerializeFMUstate(blob) if version == 2 else s2.deserializeFMUState(blob)
     (s2.setFMUstate if version == 2 else s2.setFMUState)(restored)
@@ -158,12 +160,10 @@ def test_rollback_and_serialised_states_give_identical_outputs(fmus, version):
     assert outputs(s2, version, out) == first
     s2.terminate()
     s2.freeInstance()
-    shutil.rmtree(unzipped, ignore_errors=True)
-    shutil.rmtree(unzipped2, ignore_errors=True)
 
 
-def test_the_fmu_and_the_native_c_api_give_the_same_numbers(fmus, library):
-    md, unzipped, s = slave(fmus[("drum", 2)], 2)
+def test_the_fmu_and_the_native_c_api_give_the_same_numbers(fmus, library, tmp_path):
+    md, unzipped, s = slave(fmus[("drum", 2)], 2, tmp_path / "fmu")
     start(2, s, Log())
     spin, out = drum_io(md, 2)
     lib = ctypes.CDLL(str(library))
@@ -195,7 +195,7 @@ def test_the_fmu_and_the_native_c_api_give_the_same_numbers(fmus, library):
 
 @pytest.mark.parametrize("version", [2, 3])
 def test_misuse_gets_an_error_status_and_a_logged_message(fmus, version, tmp_path):
-    md, unzipped, s = slave(fmus[("drum", version)], version)
+    md, unzipped, s = slave(fmus[("drum", version)], version, tmp_path / "fmu")
     log = Log()
     spin, out = drum_io(md, version)
     get = s.getReal if version == 2 else s.getFloat64
@@ -244,11 +244,11 @@ def test_misuse_gets_an_error_status_and_a_logged_message(fmus, version, tmp_pat
 
 
 @pytest.mark.parametrize("version", [2, 3])
-def test_a_time_step_far_above_the_suggested_one_warns_and_diverges_with_an_error(fmus, version):
+def test_a_time_step_far_above_the_suggested_one_warns_and_diverges_with_an_error(fmus, version, tmp_path):
     # dt = 5e-3 s, 230 times the suggested step: the same warning as `talus check`
     # is logged at initialisation, and the first step, whose energy balance breaks,
     # is refused and leaves the state as it was.
-    md, unzipped, s = slave(fmus[("drum", version)], version)
+    md, unzipped, s = slave(fmus[("drum", version)], version, tmp_path / "fmu")
     log = Log()
     if version == 2:
         s.instantiate(callbacks=log.fmi2())
@@ -291,9 +291,9 @@ def test_the_fmu_simulates_again_and_again_in_one_process(fmus, version):
 
 
 @pytest.mark.parametrize("version", [2, 3])
-def test_a_pose_driven_tube_follows_its_pose_input(fmus, version):
+def test_a_pose_driven_tube_follows_its_pose_input(fmus, version, tmp_path):
     """Tap the tube: lift it 1 mm and put it back; the pellets feel it."""
-    md, unzipped, s = slave(fmus[("tube", version)], version)
+    md, unzipped, s = slave(fmus[("tube", version)], version, tmp_path / "fmu")
     start(version, s, Log())
     if version == 2:
         z = vrs(md, "tube.position[3]")
