@@ -28,6 +28,7 @@
 // rewrite to `partial_cmp` would hide that intent.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+pub mod accuracy;
 pub mod analysis;
 pub mod checkpoint;
 pub mod checksum;

@@ -45,6 +45,12 @@ fn check_prints_the_plan() {
         text.contains("wall kinematics: advanced every step"),
         "{text}"
     );
+    // The errors to expect: the reference impacts at the scene's step.
+    assert!(text.contains("expected errors at dt = "), "{text}");
+    assert!(
+        text.contains("face ") && text.contains(" edge ") && text.contains("energy account"),
+        "{text}"
+    );
     // A broken scene: non-zero exit, the message names file, line and field.
     std::fs::write(dir.join("bad.toml"), SCENE.replace("END", "-1")).unwrap();
     let out = talus()
@@ -95,6 +101,27 @@ fn run_writes_the_series_and_the_summary() {
     let share: f64 = stages.iter().map(|s| s["share"].as_f64().unwrap()).sum();
     assert!((share - 1.0).abs() < 1e-9, "{share}");
     assert!(stages.iter().all(|s| s["seconds"].as_f64().unwrap() >= 0.0));
+    // The energy account closes to the steps' error, and the reference impacts
+    // (face, edge and vertex on each wall material) are listed.
+    let energy = &summary["energy"];
+    let field = |k: &str| energy[k].as_f64().unwrap();
+    let held = field("kinetic") + field("potential") + field("elastic");
+    let error = held - field("start") - field("wall_work") - field("fluid_work")
+        + field("dissipated")
+        - field("host");
+    assert!((error - field("error")).abs() <= 1e-12 * field("start").abs().max(1e-9));
+    assert!(field("relative_error").abs() < 1e-2, "{energy}");
+    let expected = summary["expected"].as_array().unwrap();
+    assert!(
+        !expected.is_empty() && expected.len() % 3 == 0,
+        "{expected:?}"
+    );
+    assert!(
+        expected
+            .iter()
+            .all(|i| i["restitution_error"].as_f64().unwrap().abs() < 0.1),
+        "{expected:?}"
+    );
     // Frames at 0, 1, ..., 5 ms and the final one.
     let pvd = std::fs::read_to_string(out_dir.join("particles.pvd")).unwrap();
     let frames = pvd.matches("<DataSet").count();

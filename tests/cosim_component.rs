@@ -601,14 +601,15 @@ fn a_state_with_a_bad_step_or_non_finite_values_is_refused_even_with_its_checksu
         body.extend_from_slice(&crc.to_le_bytes());
         body
     };
-    // Layout: magic, fingerprint, time (16), dt (24), ...; the first particle's id
-    // (88), body type (96), position (104).
+    // Layout: magic, fingerprint, time (16), dt (24), ...; the energy account
+    // (80..128), the first particle's id (136), body type (144), position (152).
     for (at, value, words) in [
         (24, -1e-4, "time step"),
         (24, 0.0, "time step"),
         (24, f64::NAN, "time step"),
         (16, f64::INFINITY, "time"),
-        (104, f64::NAN, "non-finite"),
+        (96, f64::NAN, "energy account"),
+        (152, f64::NAN, "non-finite"),
     ] {
         let err = c.state_from_bytes(&rewritten(at, value)).unwrap_err();
         assert!(err.to_string().contains(words), "{at}: {err}");

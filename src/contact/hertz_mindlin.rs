@@ -91,6 +91,8 @@ pub struct HertzMindlinForce {
     pub force: Vector3<Real>,
     /// Magnitude of the normal force (≥ 0).
     pub normal: Real,
+    /// Magnitude of its elastic part, `4/3 E* √R* δ^{3/2}` (the rest is damping).
+    pub elastic: Real,
     /// Secant normal stiffness `4/3 E* a` (what the rolling spring is scaled by).
     pub stiffness: Real,
     /// Elastic energy of the normal law, `8/15 E* √R* δ^{5/2}`.
@@ -130,6 +132,7 @@ pub fn hertz_mindlin_force(
     HertzMindlinForce {
         force: c.normal * normal + t.force,
         normal,
+        elastic,
         stiffness,
         energy: 0.4 * elastic * c.depth,
         history: t.history,

@@ -147,6 +147,11 @@ impl PairStiffness {
     }
 }
 
+/// Restitution of a contact between two materials: the mean of the two.
+pub fn pair_restitution(a: Real, b: Real) -> Real {
+    0.5 * (a + b)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -25,6 +25,14 @@ impl TangentialHistory {
     pub fn is_empty(&self) -> bool {
         self.spring == Vector3::zeros() && self.twist == 0.0 && self.rolling == Vector3::zeros()
     }
+
+    /// Elastic energy held in the friction spring, `½ k s²` (J). The twisting and
+    /// rolling springs are not counted: their small energy is booked as dissipated
+    /// while they hold it (see `engine::cpu::forces::dissipated`).
+    #[inline]
+    pub fn spring_energy(&self) -> Real {
+        0.5 * self.stiffness * self.spring.norm_squared()
+    }
 }
 
 /// The tangential force on body 2 and the updated history.

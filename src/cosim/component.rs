@@ -465,11 +465,10 @@ impl Component {
             }
         });
         self.output = output;
-        let wall_work = impulse.iter().map(|m| m.power).sum();
         if let Some(problem) = sim
             .first_non_finite()
             .map(|id| format!("particle {id} has a non-finite position, velocity or force"))
-            .or_else(|| balance.broken(sim, wall_work))
+            .or_else(|| balance.broken(sim))
         {
             sim.restore(&before)
                 .expect("a snapshot of this simulation restores");

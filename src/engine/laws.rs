@@ -15,14 +15,11 @@
 
 use super::fast_hash::FastMap;
 use crate::Real;
-use crate::contact::{DampingTable, HertzMindlinPair, PairStiffness, RollingParameters};
+use crate::contact::{
+    DampingTable, HertzMindlinPair, PairStiffness, RollingParameters, pair_restitution,
+};
 use crate::engine::RoundLaw;
 use crate::world::World;
-
-/// Restitution of a pair of materials: the mean of the two.
-fn pair_restitution(a: Real, b: Real) -> Real {
-    0.5 * (a + b)
-}
 
 /// What every contact of one pair of body types shares.
 #[derive(Clone, Copy, Debug)]

@@ -16,9 +16,15 @@ pub struct StepStats {
     pub candidate_pairs: usize,
     /// Particles integrated in the last step (owned and not frozen).
     pub integrated: usize,
-    /// Elastic energy stored in all contacts' normal laws (the potential of the
-    /// overlap volumes).
+    /// Elastic energy held in all contacts: the normal laws' potentials (of the
+    /// overlap volumes, or Hertz's) and the friction springs.
     pub elastic_energy: Real,
+    /// Energy the contacts dissipated over the step that ended with this
+    /// evaluation (damping, friction), J.
+    pub dissipated: Real,
+    /// Work of the fluid's drag and pressure-gradient forces on the particles over
+    /// that step, J.
+    pub fluid_work: Real,
     /// Neighbour-list builds since the backend was made.
     pub list_builds: u64,
 }

@@ -112,9 +112,64 @@ pub struct Summary {
     pub threads: usize,
     /// Wall-clock time of each stage of the steps, in step order.
     pub stages: Vec<StageSummary>,
+    /// The run's energy account at the end.
+    pub energy: EnergySummary,
+    /// The errors to expect of the scene's settings: one reference impact of each
+    /// particle kind on each wall material (`talus::accuracy`).
+    pub expected: Vec<ImpactSummary>,
     /// The drum's averages, with a `[drum]` section.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub drum: Option<DrumSummary>,
+}
+
+/// A run's energy account at its end (`talus::scene::energy_ledger`), J: what the
+/// particles hold against what flowed in and out since the start; the error is what
+/// the integration created (positive) or lost.
+#[derive(Clone, Copy, Debug, Default, Serialize)]
+pub struct EnergySummary {
+    /// Kinetic energy held, translation and rotation.
+    pub kinetic: Real,
+    /// Gravitational potential energy held, `−m g · x`.
+    pub potential: Real,
+    /// Elastic energy held in the contacts.
+    pub elastic: Real,
+    /// What the particles held at the start.
+    pub start: Real,
+    /// Work of the walls on the particles.
+    pub wall_work: Real,
+    /// Work of a coupled fluid's forces on the particles.
+    pub fluid_work: Real,
+    /// Energy dissipated by the contacts.
+    pub dissipated: Real,
+    /// Energy the host's changes between steps brought or took (particles
+    /// inserted, frozen, removed).
+    pub host: Real,
+    /// Held − start − work + dissipated − host.
+    pub error: Real,
+    /// The error over the largest of the energy dissipated, the work, and the
+    /// kinetic plus elastic energy brought in or held.
+    pub relative_error: Real,
+}
+
+/// One reference impact of a scene's particle kind (`talus::accuracy::Impact`).
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct ImpactSummary {
+    /// The particle kind's shape name.
+    pub kind: String,
+    /// The plane's material.
+    pub wall_material: String,
+    /// What met the plane first: "face", "edge", "vertex" or "sphere".
+    pub feature: String,
+    /// Impact speed, m/s.
+    pub speed: Real,
+    /// Restitution requested by the pair's materials.
+    pub requested: Real,
+    /// Restitution realised.
+    pub realised: Real,
+    /// `realised / requested − 1`.
+    pub restitution_error: Real,
+    /// The impact's energy account error over the energy brought in.
+    pub energy_error: Real,
 }
 
 /// A wall's state at the end of a run.

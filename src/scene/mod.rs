@@ -11,6 +11,7 @@ mod analyses;
 mod build;
 mod csv_table;
 pub mod energy_balance;
+pub mod energy_ledger;
 mod error;
 mod fluid;
 mod fluid_coupling;
@@ -98,6 +99,33 @@ impl Scene {
             regularisation_length: contact.regularisation,
             skin: contact.skin,
             round_law: contact.round_law(),
+        }
+    }
+
+    /// A scene with this one's settings (time step, contact laws, materials) that
+    /// holds `world` alone: no inlets, fluid, settling, analyses or end. The
+    /// reference problems of [`crate::accuracy`] are built so from a user's scene.
+    pub fn reference(&self, world: World) -> Scene {
+        let mut spec = self.spec.clone();
+        spec.simulation.settle = None;
+        spec.simulation.end_time = Real::INFINITY;
+        spec.bed = None;
+        spec.drum = None;
+        spec.fluid = None;
+        let next_id = world.particles.id.iter().max().map_or(0, |id| id + 1);
+        Scene {
+            file: self.file.clone(),
+            spec,
+            world,
+            inlets: Vec::new(),
+            next_id,
+            dt: self.dt,
+            suggested: self.suggested.clone(),
+            warnings: Vec::new(),
+            plan: Plan::default(),
+            drum: None,
+            bed: None,
+            shape_names: Vec::new(),
         }
     }
 

@@ -6,6 +6,7 @@ use std::ops::ControlFlow;
 use nalgebra::Vector3;
 
 use super::Scene;
+use super::energy_ledger::{EnergyLedger, HeldEnergy};
 use super::spec::{FreezeSpec, SettleSpec, UpdateInterval};
 use crate::Real;
 use crate::analysis::packing::{Bed, bed_height_of};
@@ -42,6 +43,8 @@ pub struct Simulation {
     pub(super) bed_height: Option<Real>,
     /// When the fluid's particle shares are computed again (`[fluid]`).
     pub(super) fluid_interval: Option<UpdateInterval>,
+    /// The energy account since the start.
+    pub(super) energy: EnergyLedger,
 }
 
 /// Simulated time between two measurements of the bed height (while inlets feed
@@ -87,12 +90,24 @@ impl Simulation {
             freeze: scene.spec.bed.as_ref().and_then(|b| b.freeze.clone()),
             bed_height: None,
             fluid_interval: scene.spec.fluid.as_ref().map(|f| f.update_interval),
+            energy: EnergyLedger::default(),
         };
         sim.backend.world_changed(&sim.world);
         sim.insert();
         sim.update_fluid();
-        sim.initialise();
+        sim.backend.initialise(&mut sim.world, sim.dt);
+        sim.energy = EnergyLedger::new(&sim.held_energy());
         sim
+    }
+
+    /// The energy account since the start (see [`super::energy_ledger`]).
+    pub fn energy(&self) -> &EnergyLedger {
+        &self.energy
+    }
+
+    /// The energy the particles hold now.
+    pub fn held_energy(&self) -> HeldEnergy {
+        HeldEnergy::of(&self.world, self.backend.stats())
     }
 
     /// The host's world (see the sync contract of [`crate::engine::backend`]).
@@ -156,7 +171,10 @@ impl Simulation {
     /// Evaluates the forces of the current state with the step length to come: after
     /// the host set wall poses or velocities that the first half kick must see.
     pub fn initialise(&mut self) {
+        let before = self.backend.stats().elastic_energy;
         self.backend.initialise(&mut self.world, self.dt);
+        self.energy
+            .book_host(self.backend.stats().elastic_energy - before);
     }
 
     /// Changes the walls (poses, velocities) through `change`; attached walls then
@@ -170,21 +188,25 @@ impl Simulation {
     /// Multiplies every owned particle's velocity and angular momentum by `keep` (an
     /// artificial drag that brings a bed to rest).
     pub fn damp_velocities(&mut self, keep: Real) {
+        let before = self.world.kinetic_energy();
         let p = &mut self.world.particles;
         let n = p.owned();
         p.velocity[..n].iter_mut().for_each(|v| *v *= keep);
         p.angular_momentum[..n].iter_mut().for_each(|l| *l *= keep);
         self.backend.velocities_set(&self.world);
+        self.energy.book_host(self.world.kinetic_energy() - before);
     }
 
     /// Changes anything in the world through `change` (a test's or a benchmark's set
     /// up: poses, velocities); the backend takes the whole world again and the forces
     /// are evaluated anew.
     pub fn edit_world(&mut self, change: impl FnOnce(&mut World)) {
+        let before = self.held_energy();
         change(&mut self.world);
         self.world.particles.reindex();
         self.backend.world_changed(&self.world);
-        self.initialise();
+        self.backend.initialise(&mut self.world, self.dt);
+        self.energy.book_edit(&before, &self.held_energy());
     }
 
     /// Removes the owned particles for which `remove` is true (given the world and the
@@ -196,9 +218,14 @@ impl Simulation {
         let doomed: Vec<bool> = (0..world.particles.len())
             .map(|i| i < owned && remove(world, i))
             .collect();
+        let leaving: Real = (0..owned)
+            .filter(|&i| doomed[i])
+            .map(|i| HeldEnergy::of_particles(world, i..i + 1).total())
+            .sum();
         let removed = self.world.particles.remove_where(|i| doomed[i]);
         if removed > 0 {
             self.backend.particles_removed(&self.world);
+            self.energy.book_host(-leaving);
         }
         removed
     }
@@ -239,6 +266,7 @@ impl Simulation {
         let before = self.world.time;
         self.backend.step(&mut self.world, dt);
         self.backend.sync_to_host(&mut self.world);
+        self.energy.book_step(&self.world, self.backend.stats(), dt);
         self.steps = self.steps.saturating_add(1);
         self.follow_bed(before);
         self.insert();
@@ -263,8 +291,10 @@ impl Simulation {
             p.torque[i] = Vector3::zeros();
         }
         if p.len() > first {
-            self.backend
-                .particles_added(&self.world, first..self.world.particles.len());
+            let added = first..p.len();
+            self.energy
+                .book_inserted(&HeldEnergy::of_particles(&self.world, added.clone()));
+            self.backend.particles_added(&self.world, added);
         }
     }
 
@@ -312,9 +342,11 @@ impl Simulation {
         // The pairs of frozen particles drop out of the force loop, not out of the
         // candidate lists: no rebuild is needed.
         if let Some(freeze) = &self.freeze {
+            let before = self.world.kinetic_energy();
             let frozen = freeze_buried(&mut self.world, bed, freeze, height, &member);
             if !frozen.is_empty() {
                 self.backend.particles_frozen(&self.world, &frozen);
+                self.energy.book_host(self.world.kinetic_energy() - before);
             }
         }
     }

@@ -5,13 +5,15 @@
 //! forces, which the next half kick uses, and whether they are frozen), wall poses,
 //! velocities and forces, the tangential contact history, inlet counters, box offsets
 //! and random generators, time, step count, the settling clock, the bed height last
-//! measured, and a coupled fluid's inputs, particle shares and exchange. What a scene defines once (materials, shapes, wall meshes and their facet
+//! measured, the energy account, and a coupled fluid's inputs, particle shares and
+//! exchange. What a scene defines once (materials, shapes, wall meshes and their facet
 //! grids) is not: a state is restored into a simulation of the same scene. Restoring
 //! and stepping on gives the same bits as never having saved.
 
 use nalgebra::{Isometry3, Vector3};
 
 use super::Simulation;
+use super::energy_ledger::EnergyLedger;
 use super::state_bytes::{StateError, StateReader, StateWriter};
 use crate::Real;
 use crate::engine::{ContactHistory, StepStats};
@@ -34,6 +36,8 @@ pub struct SimState {
     pub bed_height: Option<Real>,
     /// Figures of the last force evaluation (contacts and elastic energy are kept).
     pub stats: StepStats,
+    /// The energy account since the start.
+    pub energy: EnergyLedger,
     /// The owned particles.
     pub particles: Particles,
     /// Each wall's motion and forces.
@@ -106,6 +110,7 @@ impl Simulation {
             quiet_since: self.quiet_since,
             bed_height: self.bed_height,
             stats: *self.backend.stats(),
+            energy: self.energy,
             particles: world.particles.owned_only(),
             walls: world
                 .walls
@@ -181,6 +186,7 @@ impl Simulation {
         self.next_id = state.next_id;
         self.quiet_since = state.quiet_since;
         self.bed_height = state.bed_height;
+        self.energy = state.energy;
         if let (Some(f), Some(s)) = (world.fluid.as_mut(), &state.fluid) {
             f.velocity.clone_from(&s.velocity);
             f.pressure_gradient.clone_from(&s.pressure_gradient);

@@ -25,11 +25,13 @@ use crate::Real;
 use crate::contact::TangentialHistory;
 use crate::engine::ContactHistory;
 use crate::engine::StepStats;
+use crate::scene::energy_ledger::EnergyLedger;
 use crate::world::{CellShares, MomentumExchange, Particles};
 
 /// The header of a state; the digit is the format's version (4: states in checked
-/// containers; 5: the rolling spring in the contact history; 6: the fluid field).
-pub const STATE_MAGIC: &[u8; 8] = b"TALUSST6";
+/// containers; 5: the rolling spring in the contact history; 6: the fluid field; 7:
+/// the energy account).
+pub const STATE_MAGIC: &[u8; 8] = b"TALUSST7";
 
 /// Why bytes could not be restored as a state.
 #[derive(Debug, Error, PartialEq)]
@@ -251,6 +253,7 @@ impl SimState {
         w.f64(self.bed_height.unwrap_or(Real::NAN));
         w.u64(self.stats.contacts as u64);
         w.f64(self.stats.elastic_energy);
+        self.energy.sums().iter().for_each(|x| w.f64(*x));
 
         let p = &self.particles;
         w.u64(p.len() as u64);
@@ -329,6 +332,19 @@ impl SimState {
             elastic_energy: r.f64()?,
             ..StepStats::default()
         };
+        let energy = EnergyLedger {
+            start: r.f64()?,
+            wall_work: r.f64()?,
+            fluid_work: r.f64()?,
+            dissipated: r.f64()?,
+            host: r.f64()?,
+            motion_in: r.f64()?,
+        };
+        if !energy.is_finite() {
+            return Err(StateError::Corrupt(format!(
+                "the energy account is not finite: {energy:?}"
+            )));
+        }
 
         let n = r.count(8 * 22)?;
         let mut particles = Particles::default();
@@ -408,6 +424,7 @@ impl SimState {
             quiet_since: (!quiet.is_nan()).then_some(quiet),
             bed_height: (!height.is_nan()).then_some(height),
             stats,
+            energy,
             particles,
             walls,
             inlets,

@@ -5,6 +5,7 @@ mod bench;
 mod bench_shapes;
 mod checkpoint;
 mod contact;
+mod expected;
 mod fmu;
 mod run;
 #[cfg(feature = "zenoh")]

@@ -12,12 +12,13 @@ use anyhow::{Context, Result, bail};
 use indicatif::{ProgressBar, ProgressStyle};
 use talus::Real;
 use talus::checkpoint::{Checkpoint, RunProgress};
-use talus::output::{RunOutput, StageSummary, Summary, WallSummary};
+use talus::output::{EnergySummary, RunOutput, StageSummary, Summary, WallSummary};
 use talus::scene::energy_balance::EnergyBalance;
+use talus::scene::energy_ledger::EnergyReport;
 use talus::scene::spec::UpdateInterval;
 use talus::scene::{Scene, Simulation};
 
-use crate::checkpoint;
+use crate::{checkpoint, expected};
 
 /// Loads a scene, printing its warnings.
 pub fn load(path: &Path) -> Result<Scene> {
@@ -33,6 +34,7 @@ pub fn check(path: &Path) -> Result<()> {
     let scene = load(path)?;
     println!("{}: valid scene", path.display());
     print!("{}", scene.plan);
+    print!("{}", expected::describe(&scene, &expected::measure(&scene)));
     Ok(())
 }
 
@@ -198,6 +200,10 @@ fn run_loop(
             (out, c.progress)
         }
     };
+    let impacts = expected::measure(scene);
+    if !quiet {
+        eprint!("{}", expected::describe(scene, &impacts));
+    }
     let total_steps = (sim.end_time / scene.dt).ceil() as u64;
     let bar = if quiet {
         ProgressBar::hidden()
@@ -232,7 +238,6 @@ fn run_loop(
     // balance of the last BALANCE_STEPS steps broken grossly.
     let mut blown_up: Option<String> = None;
     let mut balance = EnergyBalance::start(&sim);
-    let mut wall_work = 0.0;
     let ended_by = match stopped(&sim) {
         Some(reason) => reason,
         None => {
@@ -254,9 +259,8 @@ fn run_loop(
                     ));
                     return ControlFlow::Break(Ok("diverged"));
                 }
-                wall_work += taken * sim.world().walls.iter().map(|w| w.power()).sum::<Real>();
                 if sim.steps % BALANCE_STEPS == 0 {
-                    if let Some(problem) = balance.broken(sim, wall_work) {
+                    if let Some(problem) = balance.broken(sim) {
                         blown_up = Some(format!(
                             "in the {BALANCE_STEPS} steps up to step {} (t = {:.6e} s), {problem}; \
                              the outputs hold the run up to the step before",
@@ -266,7 +270,6 @@ fn run_loop(
                         return ControlFlow::Break(Ok("diverged"));
                     }
                     balance = EnergyBalance::start(sim);
-                    wall_work = 0.0;
                 }
                 let stats = sim.stats();
                 particle_steps += stats.integrated as u64;
@@ -284,10 +287,11 @@ fn run_loop(
                     last_draw = Instant::now();
                     bar.set_position(sim.steps);
                     bar.set_message(format!(
-                        "{:.4e} s | {} particles | {} contacts",
+                        "{:.4e} s | {} particles | {} contacts | energy error {:+.1e}",
                         sim.time(),
                         sim.world().particles.owned(),
-                        stats.contacts
+                        stats.contacts,
+                        EnergyReport::of(sim).relative_error
                     ));
                 }
                 match stopped(sim) {
@@ -316,7 +320,7 @@ fn run_loop(
     }
     let drum = out.finish(sim.world())?;
     let elapsed = before.wall_clock_s + started.elapsed().as_secs_f64();
-    let summary = summary(
+    let mut summary = summary(
         scene,
         &sim,
         ended_by,
@@ -329,6 +333,7 @@ fn run_loop(
         checkpoints.threads,
         drum,
     );
+    summary.expected = expected::summarise(scene, &impacts);
     out.write_summary(&summary)?;
     if let Some(message) = blown_up {
         anyhow::bail!("{}: the run diverged: {message}", scene.file.display());
@@ -337,7 +342,7 @@ fn run_loop(
         crate::analyze::write_bed_files(scene, bed, sim.world(), dir)?;
     }
     println!(
-        "{}: {} at t = {:.6e} s after {} steps in {:.2} s ({:.3e} particle-steps/s, {:.3e} contacts/s); {} particles; output in {}",
+        "{}: {} at t = {:.6e} s after {} steps in {:.2} s ({:.3e} particle-steps/s, {:.3e} contacts/s); {} particles; energy error {:+.2e} of {:.3e} J dissipated; output in {}",
         scene.file.display(),
         match ended_by {
             "settled" => "settled",
@@ -350,6 +355,8 @@ fn run_loop(
         summary.particle_steps_per_s,
         summary.contacts_per_s,
         summary.particles,
+        summary.energy.relative_error,
+        summary.energy.dissipated,
         dir.display()
     );
     Ok(())
@@ -407,6 +414,24 @@ fn summary(
             .collect(),
         threads,
         stages: StageSummary::of(sim.stage_times()),
+        energy: energy_summary(&EnergyReport::of(sim)),
+        expected: Vec::new(),
         drum,
+    }
+}
+
+/// The energy figures of `summary.json`.
+fn energy_summary(r: &EnergyReport) -> EnergySummary {
+    EnergySummary {
+        kinetic: r.held.kinetic,
+        potential: r.held.potential,
+        elastic: r.held.elastic,
+        start: r.ledger.start,
+        wall_work: r.ledger.wall_work,
+        fluid_work: r.ledger.fluid_work,
+        dissipated: r.ledger.dissipated,
+        host: r.ledger.host,
+        error: r.error,
+        relative_error: r.relative_error,
     }
 }

@@ -13,11 +13,12 @@ const PARTICLES_PER_TASK: usize = 256;
 
 /// Adds the fluid's forces to every owned particle (frozen ones too: they give the
 /// fluid their drag, though they do not move) and, for a step (`stepped`), sums the
-/// drag's impulse over `dt` into the cells, in particle order. Nothing without a
-/// fluid.
-pub(super) fn fluid_forces(world: &mut World, dt: Real, stepped: bool) {
+/// drag's impulse over `dt` into the cells, in particle order. Returns the work the
+/// forces do on the particles over `dt` at their present velocities (J; zero
+/// without a fluid).
+pub(super) fn fluid_forces(world: &mut World, dt: Real, stepped: bool) -> Real {
     let Some(fluid) = world.fluid.as_mut() else {
-        return;
+        return 0.0;
     };
     let p = &mut world.particles;
     let n = p.owned();
@@ -51,8 +52,10 @@ pub(super) fn fluid_forces(world: &mut World, dt: Real, stepped: bool) {
         .collect();
     let mut impulse = std::mem::take(&mut fluid.exchange.impulse);
     fluid.exchange.drag.clear();
+    let mut power = 0.0;
     for (i, (drag, pressure)) in forces.into_iter().enumerate() {
         p.force[i] += drag + pressure;
+        power += (drag + pressure).dot(&p.velocity[i]);
         fluid.exchange.drag.push(drag);
         if stepped {
             fluid.weights(i, p.id[i], &p.position[i], |c, w| {
@@ -64,4 +67,5 @@ pub(super) fn fluid_forces(world: &mut World, dt: Real, stepped: bool) {
     if stepped {
         fluid.exchange.elapsed += dt;
     }
+    power * dt
 }

@@ -9,7 +9,7 @@
 
 use nalgebra::Vector3;
 
-use super::forces::{ContactForce, RelativeMotion};
+use super::forces::{ContactForce, RelativeMotion, dissipated};
 use crate::Real;
 use crate::contact::{
     HertzContact, RollingContact, RollingModel, TangentialHistory, hertz_mindlin_force,
@@ -58,7 +58,8 @@ pub(super) fn round_contact_force(
     let m = law.materials;
     let f = hertz_mindlin_force(&c, &m.hertz, m.friction, history, law.dt);
     let mut torque = lever.cross(&f.force);
-    let mut history = f.history;
+    let mut resisting = Vector3::zeros();
+    let mut kept = f.history;
     if law.rolling != RollingModel::None {
         let contact = RollingContact {
             normal: *normal,
@@ -69,15 +70,23 @@ pub(super) fn round_contact_force(
             inertia: law.rolling_inertia,
         };
         let (rolling, spring) =
-            rolling_torque(law.rolling, &m.rolling, &contact, &history.rolling, law.dt);
+            rolling_torque(law.rolling, &m.rolling, &contact, &kept.rolling, law.dt);
         torque += rolling;
-        history.rolling = spring;
+        resisting = rolling;
+        kept.rolling = spring;
     }
     ContactForce {
         force: f.force,
         torque,
-        history,
-        energy: f.energy,
+        history: kept,
+        energy: f.energy + kept.spring_energy(),
+        dissipated: dissipated(
+            (&(f.force - normal * f.elastic), &f.force),
+            &resisting,
+            motion,
+            (history, &kept),
+            law.dt,
+        ),
     }
 }
 

@@ -10,8 +10,9 @@
 //!
 //! The parts: [`motion`] (integration stages), [`pairs`] (pair contacts and gather),
 //! [`walls`] (wall stage), [`dispatch`] (shape pair → contact geometry), [`patch`]
-//! (coplanar facets merged into one contact), [`forces`] (geometry → force through
-//! the contact laws), [`contact_state`] (what persists between steps).
+//! (coplanar facets merged into one contact), [`relative_motion`] (how the bodies
+//! move at a contact), [`forces`] (geometry → force through the contact laws),
+//! [`contact_state`] (what persists between steps).
 
 mod contact_state;
 mod dispatch;
@@ -21,6 +22,7 @@ mod hertz;
 mod motion;
 mod pairs;
 mod patch;
+mod relative_motion;
 mod walls;
 
 use std::ops::Range;
@@ -111,8 +113,8 @@ impl CpuBackend {
         let totals = times.time(Stage::Gather, || {
             pairs::gather(world, list, &work.results, &mut work.touching)
         });
-        let pair_contacts = totals.0;
-        let (count, energy) = times.time(Stage::WallContacts, || {
+        let pair_contacts = totals.contacts;
+        let totals = times.time(Stage::WallContacts, || {
             let inputs = WallInputs {
                 list,
                 laws,
@@ -128,10 +130,12 @@ impl CpuBackend {
                 totals,
             )
         });
-        times.time(Stage::Fluid, || fluid::fluid_forces(world, dt, stepped));
-        stats.contacts = count;
+        let fluid_work = times.time(Stage::Fluid, || fluid::fluid_forces(world, dt, stepped));
+        stats.contacts = totals.contacts;
         stats.pair_contacts = pair_contacts;
-        stats.elastic_energy = energy;
+        stats.elastic_energy = totals.energy;
+        stats.dissipated = totals.dissipated;
+        stats.fluid_work = fluid_work;
         stats.candidate_pairs = list.pairs().len();
         stats.list_builds = list.builds();
     }

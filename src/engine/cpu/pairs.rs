@@ -6,9 +6,7 @@ use rayon::prelude::*;
 
 use super::contact_state::ContactState;
 use super::dispatch::pair_geometry;
-use super::forces::{
-    ContactForce, PairResult, RelativeMotion, inverse_mass_at, pair_force, velocity_at,
-};
+use super::forces::{ContactForce, PairResult, RelativeMotion, pair_force};
 use super::hertz::{HertzInputs, rolling_inertia, round_contact_force, round_radius, sphere_pair};
 use crate::Real;
 use crate::contact::{RollingModel, TangentialHistory, effective_radius};
@@ -80,15 +78,7 @@ fn pair_contact(
                 &world.body_types[bj as usize],
             );
             let g = pair_geometry(world, i, j, plan)?;
-            let (wi, wj) = (world.angular_velocity(i), world.angular_velocity(j));
-            let motion = RelativeMotion {
-                velocity: velocity_at(world, j, &wj, &g.point)
-                    - velocity_at(world, i, &wi, &g.point),
-                spin: wj - wi,
-                inverse_mass: inverse_mass_at(world, i, &g.point, &g.normal)
-                    + inverse_mass_at(world, j, &g.point, &g.normal),
-                inertia: 0.0,
-            };
+            let motion = RelativeMotion::of_pair(world, [i, j], &g.point, &g.normal, 0.0);
             let lever = |k: usize| (g.point - p.position[k]).norm();
             let inertia =
                 1.0 / (1.0 / rolling_inertia(ti, lever(i)) + 1.0 / rolling_inertia(tj, lever(j)));
@@ -131,13 +121,17 @@ pub(super) fn pair_contacts(
         };
         // A pair that stays apart keeps its empty history unwritten.
         match &c {
-            Some(c) => *history = c.history,
-            None if !history.is_empty() => *history = TangentialHistory::default(),
-            None => {}
+            Some(c) => {
+                *history = c.history;
+                PairResult::new(c, &p.position[i], &p.position[j])
+            }
+            None if !history.is_empty() => {
+                let parted = PairResult::parted(history);
+                *history = TangentialHistory::default();
+                parted
+            }
+            None => PairResult::default(),
         }
-        c.as_ref().map_or_else(PairResult::default, |c| {
-            PairResult::new(c, &p.position[i], &p.position[j])
-        })
     };
     results.clear();
     let pairs = list.pairs().par_iter().zip(&mut state.pair_history);
@@ -163,13 +157,13 @@ pub(super) fn pair_contacts(
 /// Sets every owned particle's force to its weight plus its pairs' forces, gathered in
 /// pair order (what a serial sweep over the pairs would add), so the sums do not
 /// depend on the threads; marks the particles that touch. Ghosts get no force.
-/// Returns the number of contacts and their elastic energy.
+/// Returns the contacts' count and energies.
 pub(super) fn gather(
     world: &mut World,
     list: &NeighbourList,
     results: &[PairResult],
     touching: &mut Vec<bool>,
-) -> (usize, Real) {
+) -> ContactTotals {
     let p = &mut world.particles;
     let owned = p.owned();
     let (types, gravity) = (&world.body_types, world.gravity);
@@ -200,10 +194,22 @@ pub(super) fn gather(
                 *torque += c.torques[role];
             }
         });
-    let (mut contacts, mut energy) = (0, 0.0);
+    let mut totals = ContactTotals::default();
     for c in results {
-        contacts += usize::from(c.touching);
-        energy += c.energy;
+        totals.contacts += usize::from(c.touching);
+        totals.energy += c.energy;
+        totals.dissipated += c.dissipated;
     }
-    (contacts, energy)
+    totals
+}
+
+/// A force evaluation's contacts, summed in pair order, then wall contacts in
+/// particle order.
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct ContactTotals {
+    pub contacts: usize,
+    /// Elastic energy held in the contacts, J.
+    pub energy: Real,
+    /// Energy dissipated over the step, J.
+    pub dissipated: Real,
 }

@@ -11,10 +11,9 @@ use nalgebra::{Isometry3, Point3, Vector3};
 use rayon::prelude::*;
 
 use super::dispatch::{facet_geometry, pose_of};
-use super::forces::{
-    ContactForce, LawInputs, RelativeMotion, contact_force, inverse_mass_at, velocity_at,
-};
+use super::forces::{ContactForce, LawInputs, RelativeMotion, contact_force};
 use super::hertz::{HertzInputs, rolling_inertia, round_contact_force};
+use super::pairs::ContactTotals;
 use super::patch::{Merge, PatchSet, plane_key};
 use crate::Real;
 use crate::contact::TangentialHistory;
@@ -98,20 +97,22 @@ pub(super) struct WallWork {
     placed: Vec<PlacedFacets>,
     /// The patches' history being written this step (swapped with the kept one).
     next_history: FastMap<WallKey, TangentialHistory>,
+    /// The contacts that ended this step, with their friction springs' energy.
+    ended: Vec<(WallKey, Real)>,
 }
 
 /// Evaluates and applies the wall contacts: particle forces and torques, wall forces,
 /// torques and facet forces, the touching flags; replaces `history` by the patches'
-/// new history. Adds the number of contacts and their elastic energy to `totals`
-/// (the pairs' figures: the energy is summed on in the same order as ever).
+/// new history. Adds the contacts' count and energies to `totals` (the pairs'
+/// figures: the energies are summed on in the same order as ever).
 pub(super) fn wall_contacts(
     world: &mut World,
     inputs: WallInputs,
     history: &mut FastMap<WallKey, TangentialHistory>,
     work: &mut WallWork,
     touching: &mut [bool],
-    totals: (usize, Real),
-) -> (usize, Real) {
+    mut totals: ContactTotals,
+) -> ContactTotals {
     for wall in &mut world.walls {
         wall.force = Vector3::zeros();
         wall.torque = Vector3::zeros();
@@ -148,12 +149,12 @@ pub(super) fn wall_contacts(
 
     let next = &mut work.next_history;
     next.clear();
-    let (mut contacts, mut energy) = totals;
     for chunk in &work.chunks[..chunks] {
         for contact in &chunk.contacts {
             let (i, c) = (contact.particle as usize, &contact.force);
-            contacts += 1;
-            energy += c.energy;
+            totals.contacts += 1;
+            totals.energy += c.energy;
+            totals.dissipated += c.dissipated;
             touching[i] = true;
             let p = &mut world.particles;
             p.force[i] += c.force;
@@ -171,10 +172,18 @@ pub(super) fn wall_contacts(
             if !c.history.is_empty() {
                 next.insert(contact.key, c.history);
             }
+            history.remove(&contact.key);
         }
     }
+    // What is left of the kept history are the contacts that ended: their friction
+    // springs are let go, in key order (the map's own order depends on its past).
+    work.ended.clear();
+    work.ended
+        .extend(history.iter().map(|(k, h)| (*k, h.spring_energy())));
+    work.ended.sort_unstable_by_key(|e| e.0);
+    totals.dissipated += work.ended.iter().map(|e| e.1).sum::<Real>();
     std::mem::swap(history, next);
-    (contacts, energy)
+    totals
 }
 
 /// Contacts of particle `i` with every wall, one per coplanar patch of facets, pushed
@@ -232,17 +241,11 @@ fn particle_contacts(
             }
         }
         let law = laws.wall(p.body_type[i], wall.material);
-        let spin = world.angular_velocity(i);
         for (key, g, facet_shares) in chunk.patches.iter() {
             if !(g.area > 0.0) || !g.normal.iter().all(|x| x.is_finite()) {
                 continue;
             }
-            let motion = RelativeMotion {
-                velocity: velocity_at(world, i, &spin, &g.point) - wall.velocity_at(&g.point),
-                spin: spin - wall.angular_velocity,
-                inverse_mass: inverse_mass_at(world, i, &g.point, &g.normal),
-                inertia: law.inertia,
-            };
+            let motion = RelativeMotion::of_wall(world, i, wall, &g.point, &g.normal, law.inertia);
             let wall_key = (p.id[i], w as u32, key);
             let h = history.get(&wall_key).copied().unwrap_or_default();
             let force = match (round, &t.shape) {
