@@ -96,13 +96,11 @@ pub fn impact_speed(scene: &Scene) -> Real {
     let (lo, hi) = heights.fold((first, first), |(lo, hi), h| (lo.min(h), hi.max(h)));
     let fall = (2.0 * g * (hi - lo)).sqrt();
     let inlets = scene.inlets.iter().map(|i| i.velocity.norm());
+    // A scene's walls carry their velocities at time 0 (`Wall::with_motion`).
     let walls = w.walls.iter().flat_map(|wall| {
-        let mut moved = wall.clone();
-        moved.set_velocity_at(0.0);
         wall.vertices
             .iter()
-            .map(move |v| moved.velocity_at(&(moved.pose * v)).norm())
-            .collect::<Vec<_>>()
+            .map(move |v| wall.velocity_at(&(wall.pose * v)).norm())
     });
     let fastest = inlets.chain(walls).fold(fall, Real::max);
     if fastest > 0.0 { fastest } else { 1.0 }

@@ -93,10 +93,10 @@ impl PairResult {
 /// `dt F · v` at the velocity between them, the step's end velocity. The contact's
 /// own whole force `total` on body 2 moves the `motion` measured (the half-step
 /// velocity) there by half a kick, `dt/2 · total / m_eff`: exact along the normal
-/// for a contact alone on its bodies, which an impact is. Where the bodies have other contacts, their
-/// kicks are left out (a quasi-static bed's are balanced; predicting them from the
-/// last step's forces misjudged the first step of every impact, whose damping stops
-/// the approach within a few steps). At the half-step velocity alone, an impact
+/// for a contact alone on its bodies, which an impact is. Where the bodies have
+/// other contacts, their kicks are left out (a quasi-static bed's are balanced;
+/// predicting them from the last step's forces misjudged the first step of every
+/// impact, whose damping stops the approach within a few steps). At the half-step velocity alone, an impact
 /// damped within a few steps is booked ~10 % too much dissipation at the suggested
 /// step.
 ///

@@ -241,11 +241,13 @@ fn particle_contacts(
             }
         }
         let law = laws.wall(p.body_type[i], wall.material);
+        let spin = world.angular_velocity(i);
         for (key, g, facet_shares) in chunk.patches.iter() {
             if !(g.area > 0.0) || !g.normal.iter().all(|x| x.is_finite()) {
                 continue;
             }
-            let motion = RelativeMotion::of_wall(world, i, wall, &g.point, &g.normal, law.inertia);
+            let motion =
+                RelativeMotion::of_wall(world, (i, &spin), wall, &g.point, &g.normal, law.inertia);
             let wall_key = (p.id[i], w as u32, key);
             let h = history.get(&wall_key).copied().unwrap_or_default();
             let force = match (round, &t.shape) {
