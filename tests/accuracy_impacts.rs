@@ -23,10 +23,11 @@ fn at(found: &[Impact], feature: Feature) -> &Impact {
     found.iter().find(|i| i.feature == feature).unwrap()
 }
 
-/// At the suggested step (measured: face −2.27 %, edge −1.03 %, vertex −0.77 %; the
-/// energy account of the face impact −1.0e-3, of the others below 4e-5).
+/// At the suggested step, the worst over where in a step the contact begins
+/// (measured: face −11.4 %, edge −1.03 %, vertex −0.77 %; the face impact's error
+/// is −2.3 % if the contact happens to begin at the start of a step).
 #[test]
-fn at_the_suggested_step_the_impacts_realise_their_restitution_within_three_percent() {
+fn at_the_suggested_step_the_impacts_realise_their_restitution() {
     let scene = settling_box("\"auto\"");
     // A fall across the box, 0.12 m high, and the inlet's 0.5 m/s.
     let speed = impact_speed(&scene);
@@ -39,18 +40,22 @@ fn at_the_suggested_step_the_impacts_realise_their_restitution_within_three_perc
     for i in &found {
         println!("{i:?}");
         assert_eq!(i.requested, 0.1);
-        assert!(i.restitution_error().abs() < 0.03, "{i:?}");
+        let bound = if i.feature == Feature::Face {
+            0.13
+        } else {
+            0.012
+        };
+        assert!(i.restitution_error().abs() < bound, "{i:?}");
         assert!(i.energy_error.abs() < 2e-3, "{i:?}");
         assert!(i.contact_steps > 20, "{i:?}");
     }
 }
 
-/// The edge and vertex impacts' restitution errors fall in proportion to the step
-/// (measured from 1 to 1/8 of the suggested step: edge −1.03, −0.52, −0.26, −0.14
-/// %), their energy accounts with its square (3.2e-5, 7.9e-6, 2.0e-6, 5.0e-7: an
-/// impact alone on its body is booked exactly to second order). The face impact
-/// meets the regularised flat law, and converges without a steady order (−2.3,
-/// −3.6, +0.34, +0.02 %).
+/// The impacts' restitution errors, worst over the phase of the first contact, fall
+/// in proportion to the step (measured from 1 to 1/8 of the suggested step: face
+/// −11.4, −5.8, −3.0, −1.7 %; edge −1.03, −0.52, −0.26, −0.14 %); the edge and
+/// vertex energy accounts fall with its square (3.2e-5, 7.9e-6, 2.0e-6, 5.0e-7: an
+/// impact alone on its body is booked exactly to second order).
 #[test]
 fn the_errors_fall_as_the_step_shrinks() {
     let suggested = settling_box("\"auto\"").dt;
@@ -66,8 +71,11 @@ fn the_errors_fall_as_the_step_shrinks() {
         let ratio = a.energy_error / b.energy_error;
         assert!((3.2..5.0).contains(&ratio), "{feature:?}: {a:?} / {b:?}");
     }
-    let face = at(&finest, Feature::Face);
-    assert!(face.restitution_error().abs() < 2e-3, "{face:?}");
+    for (a, b) in [(&coarse, &fine), (&fine, &finest)] {
+        let (a, b) = (at(a, Feature::Face), at(b, Feature::Face));
+        let ratio = a.restitution_error() / b.restitution_error();
+        assert!((1.7..2.4).contains(&ratio), "face: {a:?} / {b:?}");
+    }
 }
 
 /// A scene of Hertz spheres on two wall materials: one impact per material, each

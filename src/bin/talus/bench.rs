@@ -26,7 +26,7 @@ use rand::{Rng, SeedableRng};
 use talus::Real;
 use talus::scene::{Scene, Simulation};
 
-fn machine() -> String {
+pub fn machine() -> String {
     let model = std::fs::read_to_string("/proc/cpuinfo")
         .ok()
         .and_then(|s| {

@@ -1,5 +1,6 @@
 //! The `talus` command line.
 
+mod accuracy;
 mod analyze;
 mod bench;
 mod bench_shapes;
@@ -58,6 +59,28 @@ enum Command {
         /// No progress bar.
         #[arg(long)]
         quiet: bool,
+    },
+    /// Measure what each setting of a scene costs and buys: the time step, the
+    /// regularisation, the skin and the meshes of icosphere and prism shapes swept,
+    /// each setting's errors on reference problems built from the scene's shapes and
+    /// materials against exact answers, and its cost on a short run of the scene;
+    /// writes accuracy.csv, accuracy.json, pareto.png, convergence.png and prints the
+    /// cheapest setting that meets the target.
+    Accuracy {
+        /// The scene (TOML).
+        scene: PathBuf,
+        /// Wall-clock seconds for the cost runs on the scene.
+        #[arg(long, default_value_t = 60.0)]
+        budget: f64,
+        /// Largest error of the recommendation (0.02 or 2%).
+        #[arg(long, default_value = "2%", value_parser = accuracy::fraction)]
+        target: f64,
+        /// Output directory (default: <scene>_accuracy next to the scene).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Worker threads of the cost runs (default: the scene's, else all cores).
+        #[arg(long, default_value_t = 0)]
+        threads: usize,
     },
     /// Analyse the packed bed of a finished run (its scene's [bed] section, its
     /// poses.csv): packing.json, porosity profiles, bed.stl.
@@ -166,6 +189,21 @@ fn main() -> Result<()> {
                 quiet,
                 resume,
                 checkpoint_every,
+            },
+        ),
+        Command::Accuracy {
+            scene,
+            budget,
+            target,
+            out,
+            threads,
+        } => accuracy::accuracy(
+            &scene,
+            accuracy::AccuracyOptions {
+                budget: std::time::Duration::from_secs_f64(budget.clamp(0.0, 1e6)),
+                target,
+                out,
+                threads,
             },
         ),
         Command::Contact { file } => contact::contact(&file),

@@ -75,14 +75,7 @@ pub fn run(path: Option<&Path>, options: RunOptions) -> Result<()> {
             scene.file.display()
         );
     }
-    let threads = match (options.threads, scene.spec.simulation.threads) {
-        (0, 0) => std::thread::available_parallelism().map_or(1, |n| n.get()),
-        (0, t) | (t, _) => t,
-    };
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .context("cannot start the worker threads")?;
+    let (pool, threads) = worker_pool(options.threads, &scene)?;
     let stop = Arc::new(AtomicBool::new(false));
     {
         let stop = stop.clone();
@@ -434,4 +427,18 @@ fn energy_summary(r: &EnergyReport) -> EnergySummary {
         error: r.error,
         relative_error: r.relative_error,
     }
+}
+
+/// The worker threads of a command: `threads` if given (not 0), else the scene's
+/// `[simulation] threads`, else all cores.
+pub fn worker_pool(threads: usize, scene: &Scene) -> Result<(rayon::ThreadPool, usize)> {
+    let threads = match (threads, scene.spec.simulation.threads) {
+        (0, 0) => std::thread::available_parallelism().map_or(1, |n| n.get()),
+        (0, t) | (t, _) => t,
+    };
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .context("cannot start the worker threads")?;
+    Ok((pool, threads))
 }

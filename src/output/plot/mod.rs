@@ -3,16 +3,18 @@
 //!
 //! `plotters` draws into an RGB buffer (its bitmap backend), its text is rasterised by
 //! `ab_glyph` in DejaVu Sans (embedded by the `dejavu` crate, so no system font or
-//! fontconfig is needed), and `png` encodes the buffer. Two kinds of figure cover what
-//! talus plots:
+//! fontconfig is needed), and `png` encodes the buffer. Three kinds of figure cover
+//! what talus plots:
 //!
 //! - [`LineChart`]: curves against a common axis (drum torque over time, porosity
 //!   profiles);
+//! - [`LogChart`]: points and curves on log–log axes (errors against cost or step);
 //! - [`HeatMap`]: a scalar on rectangular cells with a colour bar, and curves drawn over
 //!   it (the drum's velocity field with the rim and the free surface).
 
 mod chart;
 mod heat_map;
+mod log_chart;
 
 use std::io;
 use std::path::Path;
@@ -23,6 +25,7 @@ use plotters::prelude::*;
 
 pub use chart::{LineChart, Series};
 pub use heat_map::{Cell, HeatMap};
+pub use log_chart::{LogChart, PointSet};
 
 /// The font family every text of a plot is set in.
 const FONT: &str = "sans-serif";
@@ -188,6 +191,46 @@ mod tests {
             count([254, 232, 37])
         );
         assert!(count([215, 215, 215]) > third * 9 / 10);
+    }
+
+    #[test]
+    fn log_chart_points_map_by_decades() {
+        let path = scratch("log.png");
+        let mut chart = LogChart::new("Two points", "cost (s)", "error (1)");
+        let colour = RGBColor(214, 39, 40);
+        chart.sets.push(PointSet {
+            name: "points".into(),
+            points: vec![(1.0, 1e-4), (100.0, 1e-2), (0.0, 1.0)],
+            colour,
+            joined: false,
+            marker: 4,
+        });
+        chart.write_png(&path).unwrap();
+        let (width, height, pixels) = read(&path);
+        let _ = std::fs::remove_file(&path);
+        assert_eq!((width, height), (800, 560));
+        // Two markers (the point at x = 0 cannot be drawn on a log axis), the second
+        // up and to the right of the first by the same distance on both axes' scales.
+        let at: Vec<(u32, u32)> = (0..pixels.len())
+            .filter(|&k| pixels[k] == [colour.0, colour.1, colour.2])
+            .map(|k| (k as u32 % width, k as u32 / width))
+            .collect();
+        let (left, right): (Vec<_>, Vec<_>) = at.iter().partition(|p| p.0 < width / 2);
+        assert!(
+            left.len() > 20 && right.len() > 20,
+            "{} {}",
+            left.len(),
+            right.len()
+        );
+        let mean = |v: &[&(u32, u32)]| {
+            let n = v.len() as f64;
+            (
+                v.iter().map(|p| p.0 as f64).sum::<f64>() / n,
+                v.iter().map(|p| p.1 as f64).sum::<f64>() / n,
+            )
+        };
+        let (a, b) = (mean(&left), mean(&right));
+        assert!(b.0 > a.0 + 300.0 && b.1 < a.1 - 200.0, "{a:?} {b:?}");
     }
 
     #[test]
