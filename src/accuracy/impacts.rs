@@ -6,7 +6,7 @@
 //! drop is made with its first contact at four places within a step ([`PHASES`]),
 //! and the worst is kept.
 
-use nalgebra::{Point3, UnitQuaternion, Vector3};
+use nalgebra::{Point3, Vector3};
 
 use super::{KINDS_CHECKED, setup};
 use crate::Real;
@@ -209,22 +209,17 @@ fn drop_at(
 ) -> Impact {
     let t = &scene.world.body_types[kind];
     let (down, point) = aim(&t.shape, feature);
-    let q = UnitQuaternion::rotation_between(&down, &-Vector3::z()).unwrap_or_else(|| {
-        UnitQuaternion::from_axis_angle(&Vector3::x_axis(), std::f64::consts::PI)
-    });
+    let q = setup::turned_down(&down);
     let radius = t.shape.circumradius();
-    let lowest = setup::depth_below(&t.shape, &q);
-    let mut world = setup::world(
+    let world = setup::dropped_on_plane(
         scene,
         |_| {},
-        vec![t.clone()],
-        vec![setup::plane(material, radius)],
+        t,
+        q,
+        material,
+        0.01 * radius + phase * speed * scene.dt,
+        Vector3::new(0.0, 0.0, -speed),
     );
-    let gap = 0.01 * radius + phase * speed * scene.dt;
-    world
-        .particles
-        .push(0, Point3::new(0.0, 0.0, lowest + gap), q, 0);
-    world.particles.velocity[0] = Vector3::new(0.0, 0.0, -speed);
     let mut sim = Simulation::new(&scene.reference(world));
     let end = setup::contact_deadline(scene, radius, speed);
     let contact_steps = setup::until_parted(&mut sim, end, |_| 0.0).contact_steps;

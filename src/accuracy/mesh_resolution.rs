@@ -74,17 +74,9 @@ fn volume_law(scene: &Scene, world: World) -> Scene {
     s
 }
 
-/// The wall material of the scene's first wall (or the kind's own).
-fn plane_material(scene: &Scene, kind: usize) -> usize {
-    let w = &scene.world;
-    w.walls
-        .first()
-        .map_or(w.body_types[kind].material, |wall| wall.material)
-}
-
 fn force_error(scene: &Scene, kind: usize, radius: Real, speed: Real) -> Real {
     let t = &scene.world.body_types[kind];
-    let material = plane_material(scene, kind);
+    let material = setup::plane_material(scene, kind);
     let sphere = BodyType::new(
         Shape::Sphere(Sphere::new(radius).expect("an icosphere's radius is positive")),
         &scene.world.materials[t.material],
@@ -132,7 +124,7 @@ fn force_error(scene: &Scene, kind: usize, radius: Real, speed: Real) -> Real {
 
 fn collision_error(scene: &Scene, kind: usize, curved: &Curved, speed: Real) -> Real {
     let t = &scene.world.body_types[kind];
-    let material = plane_material(scene, kind);
+    let material = setup::plane_material(scene, kind);
     let r = t.shape.circumradius();
     let mut rng = Pcg64::seed_from_u64(20_480);
     let mut worst: Real = 0.0;
@@ -149,17 +141,15 @@ fn collision_error(scene: &Scene, kind: usize, curved: &Curved, speed: Real) -> 
                     )
             }
         };
-        let mut world = setup::world(
+        let world = setup::dropped_on_plane(
             scene,
             setup::elastic,
-            vec![t.clone()],
-            vec![setup::plane(material, r)],
+            t,
+            q,
+            material,
+            0.01 * r,
+            Vector3::new(0.0, 0.0, -speed),
         );
-        let lowest = setup::depth_below(&t.shape, &q);
-        world
-            .particles
-            .push(0, Point3::new(0.0, 0.0, lowest + 0.01 * r), q, 0);
-        world.particles.velocity[0] = Vector3::new(0.0, 0.0, -speed);
         let mut sim = Simulation::new(&volume_law(scene, world));
         let parted =
             setup::until_parted(&mut sim, setup::contact_deadline(scene, r, speed), |_| 0.0);

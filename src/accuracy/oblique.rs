@@ -10,7 +10,7 @@
 //! the contact lasts), and only if its damping is calibrated on the effective mass
 //! at the contact point, not on the particle's mass.
 
-use nalgebra::{Point3, UnitQuaternion, Vector3};
+use nalgebra::{UnitQuaternion, Vector3};
 
 use super::impacts::{Feature, aim};
 use super::setup;
@@ -51,10 +51,7 @@ pub fn oblique_impacts(scene: &Scene, speed: Real) -> Vec<ObliqueImpact> {
         .enumerate()
         .take(super::KINDS_CHECKED)
         .filter(|(_, t)| matches!(t.shape, Shape::Polyhedron(_)))
-        .map(|(kind, t)| {
-            let material = w.walls.first().map_or(t.material, |wall| wall.material);
-            oblique_impact(scene, kind, material, speed)
-        })
+        .map(|(kind, _)| oblique_impact(scene, kind, setup::plane_material(scene, kind), speed))
         .collect()
 }
 
@@ -62,9 +59,7 @@ pub fn oblique_impacts(scene: &Scene, speed: Real) -> Vec<ObliqueImpact> {
 /// (of 12 tried) that leaves the most room between the lowest corner and the next:
 /// the longest the impact stays a single-point one.
 fn tilted(p: &ConvexPolyhedron, down: &Vector3<Real>) -> UnitQuaternion<Real> {
-    let first = UnitQuaternion::rotation_between(down, &-Vector3::z()).unwrap_or_else(|| {
-        UnitQuaternion::from_axis_angle(&Vector3::x_axis(), std::f64::consts::PI)
-    });
+    let first = setup::turned_down(down);
     let room = |q: &UnitQuaternion<Real>| {
         let (mut lowest, mut next) = (Real::INFINITY, Real::INFINITY);
         for v in p.vertices() {
@@ -100,18 +95,16 @@ fn oblique_impact(scene: &Scene, kind: usize, material: usize, speed: Real) -> O
         .min_by(|a, b| (q * *a).z.total_cmp(&(q * *b).z))
         .expect("a polyhedron has vertices");
     let radius = t.shape.circumradius();
-    let mut world = setup::world(
+    let v0 = Vector3::new(0.5 * speed, 0.0, -speed);
+    let world = setup::dropped_on_plane(
         scene,
         setup::frictionless,
-        vec![t.clone()],
-        vec![setup::plane(material, radius)],
+        t,
+        q,
+        material,
+        0.01 * radius,
+        v0,
     );
-    let lowest = setup::depth_below(&t.shape, &q);
-    world
-        .particles
-        .push(0, Point3::new(0.0, 0.0, lowest + 0.01 * radius), q, 0);
-    let v0 = Vector3::new(0.5 * speed, 0.0, -speed);
-    world.particles.velocity[0] = v0;
     let materials = &scene.world.materials;
     let e = pair_restitution(
         materials[t.material].restitution,

@@ -7,7 +7,7 @@
 //! at every step: a contact patch that spans facet edges is one contact
 //! (`engine::cpu::patch`), not a sum that depends on where the edges run.
 
-use nalgebra::{Point3, UnitQuaternion, Vector3};
+use nalgebra::{Point3, Vector3};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 
@@ -48,10 +48,8 @@ pub fn resting_layer(scene: &Scene) -> Option<RestingLayer> {
         .iter()
         .map(|t| t.shape.circumradius())
         .fold(0.0, Real::max);
-    let material = w
-        .walls
-        .first()
-        .map_or(types.first()?.material, |wall| wall.material);
+    types.first()?;
+    let material = setup::plane_material(scene, 0);
     let g = match w.gravity.norm() {
         g if g > 0.0 => g,
         _ => 9.81,
@@ -63,9 +61,7 @@ pub fn resting_layer(scene: &Scene) -> Option<RestingLayer> {
         let n = types.len() as Real;
         for (k, t) in types.iter().enumerate() {
             let (down, _) = aim(&t.shape, Feature::Face);
-            let q = UnitQuaternion::rotation_between(&down, &-Vector3::z()).unwrap_or_else(|| {
-                UnitQuaternion::from_axis_angle(&Vector3::x_axis(), std::f64::consts::PI)
-            });
+            let q = setup::turned_down(&down);
             let x = (k as Real - 0.5 * (n - 1.0)) * 3.0 * r;
             let centre = Point3::new(x, 0.37 * r * k as Real, setup::depth_below(&t.shape, &q));
             world.particles.push(k as u32, centre, q, k as u64);

@@ -37,6 +37,50 @@ pub fn world(
     }
 }
 
+/// One particle of type `t` turned by `q`, its lowest point `gap` above a plane
+/// of `material` (sized by the particle's circumradius), moving at `velocity`, in
+/// a [`world`] whose materials `change` alters.
+pub fn dropped_on_plane(
+    scene: &Scene,
+    change: impl Fn(&mut Material),
+    t: &BodyType,
+    q: UnitQuaternion<Real>,
+    material: usize,
+    gap: Real,
+    velocity: Vector3<Real>,
+) -> World {
+    let radius = t.shape.circumradius();
+    let mut world = self::world(
+        scene,
+        change,
+        vec![t.clone()],
+        vec![plane(material, radius)],
+    );
+    let lowest = depth_below(&t.shape, &q);
+    world
+        .particles
+        .push(0, Point3::new(0.0, 0.0, lowest + gap), q, 0);
+    world.particles.velocity[0] = velocity;
+    world
+}
+
+/// The material of the plane a kind meets: the scene's first wall's, or the
+/// kind's own in a scene without walls.
+pub fn plane_material(scene: &Scene, kind: usize) -> usize {
+    let w = &scene.world;
+    w.walls
+        .first()
+        .map_or(w.body_types[kind].material, |wall| wall.material)
+}
+
+/// The turn that points body direction `down` straight down (−z); a half turn
+/// about x for a direction already pointing up.
+pub fn turned_down(down: &Vector3<Real>) -> UnitQuaternion<Real> {
+    UnitQuaternion::rotation_between(down, &-Vector3::z()).unwrap_or_else(|| {
+        UnitQuaternion::from_axis_angle(&Vector3::x_axis(), std::f64::consts::PI)
+    })
+}
+
 /// Frictionless (sliding and rolling) materials.
 pub fn frictionless(m: &mut Material) {
     m.friction = 0.0;
