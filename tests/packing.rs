@@ -50,6 +50,7 @@ count = 60
 base = [0.0, 0.0, 0.0]
 radius = 0.01
 exclude = 0.005
+bridge = 0.2
 "#
     )
 }
@@ -117,6 +118,53 @@ fn check_capped_stl(path: &Path, gap: f64, shells: usize) {
             assert!(d > gap * 0.999, "two capped particles {d} apart");
         }
     }
+}
+
+/// The STL of a bridged bed: closed and oriented (as [`check_capped_stl`]), in
+/// fewer shells than particles (bridges join them), enclosing the particles'
+/// volume give or take their overlaps and the bridges' necks (a few per cent).
+fn check_bridged_stl(path: &Path, particles: usize, particle_volume: f64) {
+    use std::collections::HashMap;
+    let mesh = talus::geometry::mesh_io::read_stl(path).unwrap();
+    let mut edges: HashMap<(usize, usize), usize> = HashMap::new();
+    for t in &mesh.triangles {
+        for e in 0..3 {
+            *edges.entry((t[e], t[(e + 1) % 3])).or_default() += 1;
+        }
+    }
+    for (&(u, v), &count) in &edges {
+        assert_eq!(count, 1, "edge {u}-{v} in {count} facets the same way");
+        assert_eq!(edges.get(&(v, u)), Some(&1), "edge {u}-{v} open");
+    }
+    let mut shell: Vec<usize> = (0..mesh.vertices.len()).collect();
+    fn root(shell: &mut [usize], mut v: usize) -> usize {
+        while shell[v] != v {
+            shell[v] = shell[shell[v]];
+            v = shell[v];
+        }
+        v
+    }
+    for &(u, v) in edges.keys() {
+        let (a, b) = (root(&mut shell, u), root(&mut shell, v));
+        shell[a] = b;
+    }
+    let shells: std::collections::HashSet<usize> = (0..mesh.vertices.len())
+        .map(|v| root(&mut shell, v))
+        .collect();
+    assert!(shells.len() < particles / 2, "{} shells", shells.len());
+    let enclosed: f64 = mesh
+        .triangles
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|v| mesh.vertices[v].coords);
+            a.dot(&b.cross(&c)) / 6.0
+        })
+        .sum();
+    let ratio = enclosed / particle_volume;
+    assert!(
+        ratio > 0.97 && ratio < 1.1,
+        "enclosed {ratio} of the particles"
+    );
 }
 
 fn json(path: &Path) -> serde_json::Value {
@@ -193,6 +241,13 @@ fn a_run_writes_the_packing_and_analyze_reproduces_it() {
     // The capped bed for a CFD mesher: 60 closed shells, every two at least the
     // gap (d/100) apart, and the contacts they were capped at.
     check_capped_stl(&out.join("bed_caps.stl"), 5e-5, 60);
+    // The bridged bed: one closed surface of the particles and their bridges.
+    let icosphere = talus::geometry::ConvexPolyhedron::from_convex_mesh(
+        &talus::geometry::generators::icosphere_mesh(2, 0.0025).unwrap(),
+    )
+    .unwrap()
+    .volume();
+    check_bridged_stl(&out.join("bed_bridges.stl"), 60, 60.0 * icosphere);
     let contacts = std::fs::read_to_string(out.join("contacts.csv")).unwrap();
     let rows: Vec<Vec<f64>> = contacts
         .lines()
@@ -349,7 +404,7 @@ fn feeding_by_the_bed_needs_a_bed_section() {
         let text = scene(0.1)
             .replace("count = 60", &format!("count = 60\n{line}"))
             .replace(
-                "[bed]\nbase = [0.0, 0.0, 0.0]\nradius = 0.01\nexclude = 0.005\n",
+                "[bed]\nbase = [0.0, 0.0, 0.0]\nradius = 0.01\nexclude = 0.005\nbridge = 0.2\n",
                 "",
             );
         let err = talus::scene::Scene::parse(&text, Path::new("bed.toml")).unwrap_err();

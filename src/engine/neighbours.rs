@@ -13,9 +13,15 @@
 //! spheres overlap, and every facet a particle's bounding sphere can reach, is listed.
 //!
 //! # Order
-//! Pairs are sorted by `(i, j)` and each particle's facets by index, so the contacts
-//! found through the lists come in an order that depends on the state alone, not on
-//! when the lists were built: a run restored from a saved state continues bit for bit.
+//! A pair's first particle is the one of smaller id, and pairs are sorted by the
+//! ids of their two particles; each particle's facets are sorted by index. So the
+//! contacts found through the lists come in an order that depends on the state
+//! alone, neither on when the lists were built (a run restored from a saved state
+//! continues bit for bit) nor on where the particles lie in the arrays: a pair is
+//! evaluated with the same particle first, and each particle gathers its pairs in
+//! the order of its partners' ids, whether the particles are stored in the order of
+//! their ids or not (a rank of a domain decomposition keeps its own particles
+//! first and copies of its neighbours' after them).
 //!
 //! # Why
 //! Rebuilding the grid, counting and writing the pairs every step cost as much as the
@@ -67,10 +73,10 @@ pub struct NeighbourList {
     /// Skin width; `None`: [`DEFAULT_SKIN`] times the smallest bounding radius.
     pub skin: Option<Real>,
     broad: BroadPhase,
-    /// Candidate pairs `[i, j]`, `i < j`, sorted.
+    /// Candidate pairs `[i, j]`, `id[i] < id[j]`, sorted by `(id[i], id[j])`.
     pairs: Vec<[u32; 2]>,
     /// `incident[incident_starts[k]..incident_starts[k + 1]]`: the pairs holding
-    /// particle `k`, ascending.
+    /// particle `k`, ascending (so its partners come in the order of their ids).
     incident_starts: Vec<u32>,
     incident: Vec<Incidence>,
     /// `facets[facet_starts[k * walls + w]..facet_starts[k * walls + w + 1]]`: the
@@ -95,7 +101,7 @@ impl NeighbourList {
         self.valid = false;
     }
 
-    /// Candidate pairs, sorted.
+    /// Candidate pairs, the particle of smaller id first, sorted by the two ids.
     pub fn pairs(&self) -> &[[u32; 2]] {
         &self.pairs
     }
@@ -161,7 +167,7 @@ impl NeighbourList {
 
         self.broad
             .find_pairs(&p.position, radii, skin, &mut self.pairs);
-        self.pairs.par_sort_unstable();
+        sort_by_ids(&mut self.pairs, &p.id);
         self.index_incident(n);
 
         let walls = world.walls.len();
@@ -199,7 +205,8 @@ impl NeighbourList {
         self.builds += 1;
     }
 
-    /// Fills the per-particle incidence lists of the (sorted) pairs.
+    /// Fills the per-particle incidence lists of the (sorted) pairs: each list
+    /// ascending, so a particle meets its partners in the order of their ids.
     fn index_incident(&mut self, n: usize) {
         assert!(
             self.pairs.len() < Incidence::FIRST as usize,
@@ -225,6 +232,24 @@ impl NeighbourList {
                 fill[k] += 1;
             }
         }
+    }
+}
+
+/// Orients every pair `[i, j]` (given with `i < j`) so that `id[i] < id[j]` and
+/// sorts the pairs by `(id[i], id[j])`. Where the ids ascend with the index
+/// (particles stored in the order of their ids) that is the order of the indices,
+/// and sorted as such.
+fn sort_by_ids(pairs: &mut [[u32; 2]], id: &[u64]) {
+    if id.is_sorted() {
+        pairs.par_sort_unstable();
+    } else {
+        let key = |&[i, j]: &[u32; 2]| (id[i as usize], id[j as usize]);
+        pairs.par_iter_mut().for_each(|pair| {
+            if id[pair[0] as usize] > id[pair[1] as usize] {
+                pair.swap(0, 1);
+            }
+        });
+        pairs.par_sort_unstable_by_key(key);
     }
 }
 

@@ -32,7 +32,7 @@ mod mass;
 pub mod mesh_io;
 pub mod overlap;
 mod plane;
-mod polygon;
+pub(crate) mod polygon;
 mod polyhedron;
 pub mod quadrature;
 mod rotation;

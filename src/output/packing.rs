@@ -19,7 +19,10 @@
 //! - `bed_caps.stl`: every particle capped where it touches a neighbour or the
 //!   tube, a gap apart from all ([`crate::analysis::packing::mesher`]), and
 //!   `contacts.csv` (`id_i,id_j,x,y,z,nx,ny,nz,gap`): the contacts closer than that
-//!   gap, normal from `i` to `j`, gap negative for an overlap.
+//!   gap, normal from `i` to `j`, gap negative for an overlap;
+//! - `bed_bridges.stl` (with `[bed] bridge`): the particles at full size joined by a
+//!   small prism at each of those contacts and to the tube's wall and floor, united
+//!   into one closed surface ([`crate::analysis::packing::bridges`]).
 
 use std::fs::File;
 use std::io::{self, BufWriter, Write};
@@ -31,6 +34,7 @@ use crate::Real;
 use plotters::chart::SeriesLabelPosition;
 
 use super::plot::LineChart;
+use crate::analysis::packing::bridges::{bridged_bed, bridges};
 use crate::analysis::packing::mesher::{SPHERE_LEVEL, bed_contacts, capped_particles};
 use crate::analysis::packing::{Bed, Packing, PorosityMap};
 use crate::geometry::Shape;
@@ -263,8 +267,9 @@ pub fn parse_poses(text: &str, path: &Path, world: &mut World) -> Result<(), Str
     Ok(())
 }
 
-/// Writes `bed_caps.stl` and `contacts.csv` (see the module docs).
-pub fn write_capped_bed(dir: &Path, world: &World, bed: &Bed) -> io::Result<()> {
+/// Writes `contacts.csv`, `bed_caps.stl` and, if the bed asks for bridges,
+/// `bed_bridges.stl` (see the module docs).
+pub fn write_mesher_beds(dir: &Path, world: &World, bed: &Bed) -> io::Result<()> {
     let gap = bed.cap_gap(world);
     let contacts = bed_contacts(world, gap).map_err(io::Error::other)?;
     let mut out = BufWriter::new(File::create(dir.join("contacts.csv"))?);
@@ -279,6 +284,16 @@ pub fn write_capped_bed(dir: &Path, world: &World, bed: &Bed) -> io::Result<()> 
         )?;
     }
     out.flush()?;
+    if let Some(diameter) = bed.options.bridge {
+        let bridges =
+            bridges(world, &bed.tube, gap, diameter, &contacts).map_err(io::Error::other)?;
+        let solid = bridged_bed(world, &bridges).map_err(io::Error::other)?;
+        write_stl(
+            &dir.join("bed_bridges.stl"),
+            &solid.vertices,
+            &solid.triangles,
+        )?;
+    }
     let capped = capped_particles(world, &bed.tube, gap, &contacts).map_err(io::Error::other)?;
     let mut vertices = Vec::new();
     let mut triangles = Vec::new();
@@ -287,7 +302,8 @@ pub fn write_capped_bed(dir: &Path, world: &World, bed: &Bed) -> io::Result<()> 
         vertices.extend(c.vertices);
         triangles.extend(c.triangles.iter().map(|t| t.map(|v| v as usize + base)));
     }
-    write_stl(&dir.join("bed_caps.stl"), &vertices, &triangles)
+    write_stl(&dir.join("bed_caps.stl"), &vertices, &triangles)?;
+    Ok(())
 }
 
 /// Writes `bed.stl`: every particle's surface in place, scaled by `shrink` about

@@ -133,6 +133,14 @@ pub(super) fn resolve_bed(spec: &BedSpec) -> Result<Bed, FieldError> {
     if let Some(g) = spec.cap_gap {
         positive(path.key("cap_gap"), g)?;
     }
+    if let Some(b) = spec.bridge
+        && !(b > 0.0 && b <= 1.0)
+    {
+        return Err(FieldError::new(
+            path.key("bridge"),
+            format!("{b} is not in (0, 1]: the bridge's diameter over the particle's"),
+        ));
+    }
     if !(spec.shrink > 0.0 && spec.shrink <= 1.0) {
         return Err(FieldError::new(
             path.key("shrink"),
@@ -152,6 +160,7 @@ pub(super) fn resolve_bed(spec: &BedSpec) -> Result<Bed, FieldError> {
             gap: spec.gap,
             region: None,
             cap_gap: spec.cap_gap,
+            bridge: spec.bridge,
         },
     })
 }

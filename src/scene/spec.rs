@@ -206,6 +206,10 @@ pub struct BedSpec {
     /// The gap `bed_caps.stl` leaves between capped particles and between them and
     /// the tube (default d/100; see [`crate::analysis::packing::mesher`]).
     pub cap_gap: Option<Real>,
+    /// Write `bed_bridges.stl`: the particles joined by bridges of this diameter,
+    /// relative to the smaller particle's volume-equivalent diameter (see
+    /// [`crate::analysis::packing::bridges`]); absent: no bridged bed.
+    pub bridge: Option<Real>,
     /// Freeze the buried part of the bed while it is fed (see [`FreezeSpec`]).
     pub freeze: Option<FreezeSpec>,
 }

@@ -30,7 +30,8 @@ use crate::Real;
 use crate::geometry::generators::icosphere_mesh;
 use crate::geometry::gjk::{GjkResult, gjk};
 use crate::geometry::overlap::overlap;
-use crate::geometry::{ConvexPolyhedron, GeometryError, Shape};
+use crate::geometry::polygon::{clip_by_plane, vector_area};
+use crate::geometry::{ConvexPolyhedron, GeometryError, Plane, Shape};
 use crate::world::World;
 
 /// Icosphere level of a sphere in `bed.stl` and the caps (320 facets).
@@ -57,7 +58,7 @@ pub struct BedContact {
 }
 
 /// Each body type's shape as a polyhedron: itself, or a sphere's icosphere.
-fn templates(world: &World) -> Result<Vec<Arc<ConvexPolyhedron>>, GeometryError> {
+pub(super) fn templates(world: &World) -> Result<Vec<Arc<ConvexPolyhedron>>, GeometryError> {
     let mut balls: HashMap<u64, Arc<ConvexPolyhedron>> = HashMap::new();
     world
         .body_types
@@ -80,7 +81,11 @@ fn templates(world: &World) -> Result<Vec<Arc<ConvexPolyhedron>>, GeometryError>
 }
 
 /// The pose of particle `i`'s template (its own body frame) in the world.
-fn placement(world: &World, templates: &[Arc<ConvexPolyhedron>], i: usize) -> Isometry3<Real> {
+pub(super) fn placement(
+    world: &World,
+    templates: &[Arc<ConvexPolyhedron>],
+    i: usize,
+) -> Isometry3<Real> {
     let p = &world.particles;
     let body = Isometry3::from_parts(p.position[i].coords.into(), p.orientation[i]);
     match world.body_types[p.body_type[i] as usize].shape {
@@ -115,12 +120,20 @@ fn contacts(world: &World, templates: &[Arc<ConvexPolyhedron>], within: Real) ->
                     distance,
                     point_a,
                     point_b,
-                } => (distance <= within).then(|| BedContact {
-                    i,
-                    j,
-                    point: a * Point3::from((point_a.coords + point_b.coords) * 0.5),
-                    normal: a * ((point_b - point_a) / distance),
-                    gap: distance,
+                } => (distance <= within).then(|| {
+                    let (point_a, point_b) = (a * point_a, a * point_b);
+                    let normal = (point_b - point_a) / distance;
+                    let shared =
+                        shared_face_centre([ta, tb], [&a, &b], [&point_a, &point_b], &normal)
+                            .map(|c| c + normal * (0.5 * distance));
+                    BedContact {
+                        i,
+                        j,
+                        point: shared
+                            .unwrap_or(Point3::from((point_a.coords + point_b.coords) * 0.5)),
+                        normal,
+                        gap: distance,
+                    }
                 }),
                 GjkResult::Intersecting => overlap(ta, tb, &b_in_a).map(|o| BedContact {
                     i,
@@ -132,6 +145,61 @@ fn contacts(world: &World, templates: &[Arc<ConvexPolyhedron>], within: Real) ->
             }
         })
         .collect()
+}
+
+/// Where two particles apart face each other with parallel faces (stacked
+/// cylinders, cubes face to face), the closest points GJK returns may lie anywhere
+/// on the faces' common part, often on its rim: the centroid of that common part,
+/// on `A`'s face through `on_a`, is the contact's point instead (`on_b`: the
+/// closest point on `B`). `None` unless both
+/// particles have a face across the gap (normal `n` from `A` to `B`).
+fn shared_face_centre(
+    shapes: [&ConvexPolyhedron; 2],
+    poses: [&Isometry3<Real>; 2],
+    [on_a, on_b]: [&Point3<Real>; 2],
+    n: &Vector3<Real>,
+) -> Option<Point3<Real>> {
+    const PARALLEL: Real = 1e-9;
+    let face_along = |k: usize, dir: Vector3<Real>, through: &Point3<Real>| {
+        let (poly, pose) = (shapes[k], poses[k]);
+        let tolerance = 1e-9 * poly.circumradius();
+        (0..poly.face_count()).find_map(|f| {
+            let plane = poly.planes()[f].transformed(pose);
+            (plane.normal.dot(&dir) > 1.0 - PARALLEL && plane.distance(through).abs() < tolerance)
+                .then(|| {
+                    poly.face(f)
+                        .iter()
+                        .map(move |&v| pose * poly.vertices()[v as usize])
+                })
+        })
+    };
+    let mut common: Vec<Point3<Real>> = face_along(0, *n, on_a)?.collect();
+    // B's face moved across the gap onto A's plane.
+    let across = n * n.dot(&(on_b - on_a));
+    let b_face: Vec<Point3<Real>> = face_along(1, -n, on_b)?.map(|x| x - across).collect();
+    let (mut dist, mut scratch) = (Vec::new(), Vec::new());
+    for k in 0..b_face.len() {
+        let (u, v) = (b_face[k], b_face[(k + 1) % b_face.len()]);
+        // B's face runs counter-clockwise about −n: its inside lies to the left.
+        let Some(side) = (v - u).cross(&-n).try_normalize(1e-300) else {
+            continue;
+        };
+        let plane = Plane {
+            normal: side,
+            offset: side.dot(&u.coords),
+        };
+        clip_by_plane(&mut common, &plane, &mut dist, &mut scratch);
+    }
+    let area = vector_area(&common).norm();
+    (common.len() >= 3 && area > 0.0).then(|| {
+        let p0 = common[0];
+        let mut moment = Vector3::zeros();
+        for k in 1..common.len() - 1 {
+            let a = 0.5 * (common[k] - p0).cross(&(common[k + 1] - p0)).norm();
+            moment += (p0.coords + common[k].coords + common[k + 1].coords) * (a / 3.0);
+        }
+        Point3::from(moment / area)
+    })
 }
 
 /// A half-space `normal · x ≤ offset` (world frame).

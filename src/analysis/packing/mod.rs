@@ -32,6 +32,7 @@
 //! template's z axis (a prism's axis); its angle to the tube's axis is binned by
 //! `cos θ` (isotropic orientations are uniform in `cos θ`).
 
+pub mod bridges;
 mod clipped;
 mod coordination;
 mod map;
@@ -101,8 +102,12 @@ pub struct PackingOptions {
     pub gap: Option<Real>,
     /// Region to analyse instead of the one derived from the bed height.
     pub region: Option<(Real, Real)>,
-    /// Gap between capped particles (default d/100; see [`mesher`]).
+    /// Gap between capped particles (default d/100; see [`mesher`]); also the
+    /// reach of the bridges.
     pub cap_gap: Option<Real>,
+    /// Bridge diameter over the particle diameter; `None`: no bridged bed (see
+    /// [`bridges`]).
+    pub bridge: Option<Real>,
 }
 
 impl Bed {
@@ -493,5 +498,7 @@ fn orientations(world: &World, axis: &Vector3<Real>) -> (Vec<usize>, Option<Real
     (histogram, (count > 0).then(|| order / count as Real))
 }
 
+#[cfg(test)]
+mod bridge_tests;
 #[cfg(test)]
 mod tests;

@@ -8,7 +8,7 @@ use nalgebra::UnitQuaternion;
 use std::f64::consts::PI;
 use std::sync::Arc;
 
-fn world_of(shape: Shape, placements: &[(Point3<Real>, UnitQuaternion<Real>)]) -> World {
+pub(super) fn world_of(shape: Shape, placements: &[(Point3<Real>, UnitQuaternion<Real>)]) -> World {
     let material = Material {
         name: "m".into(),
         density: 1000.0,

@@ -6,7 +6,7 @@ use std::path::Path;
 use anyhow::{Context, Result, anyhow, bail};
 use talus::analysis::packing::{Bed, analyse, porosity_map};
 use talus::output::packing::{
-    read_poses, write_bed_stl, write_capped_bed, write_packing, write_porosity_map, write_poses,
+    read_poses, write_bed_stl, write_mesher_beds, write_packing, write_porosity_map, write_poses,
 };
 use talus::scene::Scene;
 use talus::world::World;
@@ -17,7 +17,7 @@ pub fn write_bed_files(scene: &Scene, bed: &Bed, world: &World, dir: &Path) -> R
     write_poses(dir, world, &scene.shape_names)?;
     let shrink = scene.spec.bed.as_ref().map_or(1.0, |b| b.shrink);
     write_bed_stl(dir, world, shrink)?;
-    write_capped_bed(dir, world, bed)?;
+    write_mesher_beds(dir, world, bed)?;
     let packing = analyse(world, bed).map_err(|e| anyhow!("packing analysis: {e}"))?;
     write_packing(dir, &packing)?;
     let map = porosity_map(world, bed, &packing).map_err(|e| anyhow!("porosity map: {e}"))?;
