@@ -70,14 +70,11 @@ fn talus(dir: &Path, args: &[&str]) -> std::process::Output {
         .unwrap()
 }
 
-/// The STL of a capped bed: every edge shared by exactly two facets in opposite
-/// directions (closed, oriented shells), `shells` of them (connected by edges), and
-/// every two at least `gap` apart (GJK between their hulls; the STL's single
-/// precision allows 1e-3 of the gap).
-fn check_capped_stl(path: &Path, gap: f64, shells: usize) {
+/// The shells of a closed, oriented STL: asserts every edge is shared by exactly
+/// two facets in opposite directions; returns the mesh and the vertices of each
+/// shell (the components of its edge graph).
+fn closed_shells(path: &Path) -> (talus::geometry::TriMesh, Vec<Vec<nalgebra::Point3<f64>>>) {
     use std::collections::HashMap;
-    use talus::geometry::ConvexPolyhedron;
-    use talus::geometry::gjk::gjk;
     let mesh = talus::geometry::mesh_io::read_stl(path).unwrap();
     let mut edges: HashMap<(usize, usize), usize> = HashMap::new();
     for t in &mesh.triangles {
@@ -89,7 +86,6 @@ fn check_capped_stl(path: &Path, gap: f64, shells: usize) {
         assert_eq!(count, 1, "edge {u}-{v} in {count} facets the same way");
         assert_eq!(edges.get(&(v, u)), Some(&1), "edge {u}-{v} open");
     }
-    // Shells: components of the vertex graph.
     let mut shell: Vec<usize> = (0..mesh.vertices.len()).collect();
     fn root(shell: &mut [usize], mut v: usize) -> usize {
         while shell[v] != v {
@@ -106,9 +102,19 @@ fn check_capped_stl(path: &Path, gap: f64, shells: usize) {
     for (v, x) in mesh.vertices.iter().enumerate() {
         points.entry(root(&mut shell, v)).or_default().push(*x);
     }
+    (mesh, points.into_values().collect())
+}
+
+/// The STL of a capped bed: closed, oriented shells ([`closed_shells`]), `shells`
+/// of them, every two at least `gap` apart (GJK between their hulls; the STL's
+/// single precision allows 1e-3 of the gap).
+fn check_capped_stl(path: &Path, gap: f64, shells: usize) {
+    use talus::geometry::ConvexPolyhedron;
+    use talus::geometry::gjk::gjk;
+    let (_, points) = closed_shells(path);
     assert_eq!(points.len(), shells);
     let hulls: Vec<ConvexPolyhedron> = points
-        .values()
+        .iter()
         .map(|p| ConvexPolyhedron::from_hull(p).unwrap())
         .collect();
     for (a, ha) in hulls.iter().enumerate() {
@@ -120,37 +126,11 @@ fn check_capped_stl(path: &Path, gap: f64, shells: usize) {
     }
 }
 
-/// The STL of a bridged bed: closed and oriented (as [`check_capped_stl`]), in
-/// fewer shells than particles (bridges join them), enclosing the particles'
-/// volume give or take their overlaps and the bridges' necks (a few per cent).
+/// The STL of a bridged bed: closed and oriented ([`closed_shells`]), in fewer
+/// shells than particles (bridges join them), enclosing the particles' volume give
+/// or take their overlaps and the bridges' necks (a few per cent).
 fn check_bridged_stl(path: &Path, particles: usize, particle_volume: f64) {
-    use std::collections::HashMap;
-    let mesh = talus::geometry::mesh_io::read_stl(path).unwrap();
-    let mut edges: HashMap<(usize, usize), usize> = HashMap::new();
-    for t in &mesh.triangles {
-        for e in 0..3 {
-            *edges.entry((t[e], t[(e + 1) % 3])).or_default() += 1;
-        }
-    }
-    for (&(u, v), &count) in &edges {
-        assert_eq!(count, 1, "edge {u}-{v} in {count} facets the same way");
-        assert_eq!(edges.get(&(v, u)), Some(&1), "edge {u}-{v} open");
-    }
-    let mut shell: Vec<usize> = (0..mesh.vertices.len()).collect();
-    fn root(shell: &mut [usize], mut v: usize) -> usize {
-        while shell[v] != v {
-            shell[v] = shell[shell[v]];
-            v = shell[v];
-        }
-        v
-    }
-    for &(u, v) in edges.keys() {
-        let (a, b) = (root(&mut shell, u), root(&mut shell, v));
-        shell[a] = b;
-    }
-    let shells: std::collections::HashSet<usize> = (0..mesh.vertices.len())
-        .map(|v| root(&mut shell, v))
-        .collect();
+    let (mesh, shells) = closed_shells(path);
     assert!(shells.len() < particles / 2, "{} shells", shells.len());
     let enclosed: f64 = mesh
         .triangles

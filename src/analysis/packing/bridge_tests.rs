@@ -11,7 +11,7 @@ use rand::{Rng, SeedableRng};
 use super::Tube;
 use super::bridges::{BRIDGE_SIDES, Bridge, Surface, bridged_bed, bridges};
 use super::mesher::bed_contacts;
-use super::tests::world_of;
+use super::tests::{pressed_spheres, tube, world_of};
 use crate::Real;
 use crate::geometry::generators::{cuboid, icosphere_mesh};
 use crate::geometry::{ConvexPolyhedron, Shape, Sphere};
@@ -217,24 +217,8 @@ fn two_cubes_apart_are_joined_by_one_prism_across_the_gap() {
 /// standard errors).
 #[test]
 fn bridged_spheres_are_one_closed_surface_with_the_parts_volume() {
-    let tube = Tube {
-        base: Point3::new(0.3, -0.2, 0.0),
-        axis: Vector3::z(),
-        radius: 1.5,
-    };
-    let gap = 0.01;
-    let at = |rho: Real, phi: Real, z: Real| {
-        let x = Point3::new(0.3 + rho * phi.cos(), -0.2 + rho * phi.sin(), z);
-        (x, UnitQuaternion::identity())
-    };
-    let placements = [
-        at(0.0, 0.0, 0.49),  // into the floor
-        at(0.0, 0.0, 1.45),  // into the one below
-        at(0.98, 0.0, 0.5),  // into the first, near the wall
-        at(1.01, 2.0, 1.45), // into the wall
-        at(0.99, 2.0, 0.5),  // into the wall, beside the one above
-        at(0.0, 0.0, 3.0),   // alone
-    ];
+    let (tube, gap) = (tube(1.5), 0.01);
+    let placements = pressed_spheres();
     let world = world_of(Shape::Sphere(Sphere::new(0.5).unwrap()), &placements);
     let contacts = bed_contacts(&world, gap).unwrap();
     let found = bridges(&world, &tube, gap, 0.2, &contacts).unwrap();

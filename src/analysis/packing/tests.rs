@@ -30,7 +30,7 @@ pub(super) fn world_of(shape: Shape, placements: &[(Point3<Real>, UnitQuaternion
     world
 }
 
-fn tube(radius: Real) -> Tube {
+pub(super) fn tube(radius: Real) -> Tube {
     Tube {
         base: Point3::new(0.3, -0.2, 0.0),
         axis: Vector3::z(),
@@ -340,6 +340,23 @@ fn the_contacts_of_cubes_apart_and_overlapping() {
     );
 }
 
+/// Six spheres of radius 0.5 in [`tube`]`(1.5)`, pressed into each other, the floor
+/// and the wall, and one alone.
+pub(super) fn pressed_spheres() -> [(Point3<Real>, UnitQuaternion<Real>); 6] {
+    let at = |rho: Real, phi: Real, z: Real| {
+        let x = Point3::new(0.3 + rho * phi.cos(), -0.2 + rho * phi.sin(), z);
+        (x, UnitQuaternion::identity())
+    };
+    [
+        at(0.0, 0.0, 0.49),  // into the floor
+        at(0.0, 0.0, 1.45),  // into the one below
+        at(0.98, 0.0, 0.5),  // into the first, near the wall
+        at(1.01, 2.0, 1.45), // into the wall
+        at(0.99, 2.0, 0.5),  // into the wall, beside the one above
+        at(0.0, 0.0, 3.0),   // alone
+    ]
+}
+
 /// Spheres pressed into each other, the floor and the tube wall: every capped
 /// particle is a closed shell, every two at least the gap apart, all inside the
 /// tube's caps, and little of each is cut off.
@@ -348,18 +365,7 @@ fn capped_spheres_are_closed_and_a_gap_apart() {
     use super::mesher::{bed_contacts, capped_particles};
     use crate::geometry::gjk::gjk;
     let (t, gap) = (tube(1.5), 0.01);
-    let at = |rho: Real, phi: Real, z: Real| {
-        let x = Point3::new(0.3 + rho * phi.cos(), -0.2 + rho * phi.sin(), z);
-        (x, UnitQuaternion::identity())
-    };
-    let placements = [
-        at(0.0, 0.0, 0.49),  // into the floor
-        at(0.0, 0.0, 1.45),  // into the one below
-        at(0.98, 0.0, 0.5),  // into the first, near the wall
-        at(1.01, 2.0, 1.45), // into the wall
-        at(0.99, 2.0, 0.5),  // into the wall, beside the one above
-        at(0.0, 0.0, 3.0),   // alone
-    ];
+    let placements = pressed_spheres();
     let world = world_of(Shape::Sphere(Sphere::new(0.5).unwrap()), &placements);
     let contacts = bed_contacts(&world, gap).unwrap();
     let capped = capped_particles(&world, &t, gap, &contacts).unwrap();
