@@ -49,6 +49,19 @@ pub enum GeometryError {
         /// The point being added.
         point: usize,
     },
+    /// A half-space cut would leave nothing of a polytope.
+    #[error("cutting the {count}-vertex polytope by a plane leaves nothing of it")]
+    CutAway {
+        /// Number of vertices before the cut.
+        count: usize,
+    },
+    /// The faces left by a half-space cut do not leave one loop open for the new
+    /// face (round-off in a cut through many vertices at once).
+    #[error("cutting the {count}-vertex polytope by a plane leaves no single open loop to close")]
+    CutRoundOff {
+        /// Number of vertices with the cut's crossing points.
+        count: usize,
+    },
     /// A facet has (almost) no area.
     #[error("facet {facet} has zero area (vertices {a}, {b}, {c})")]
     ZeroAreaFacet {

@@ -11,6 +11,7 @@
 //! - [`generators`]: cuboids, Platonic solids, prism cylinders, icospheres, random
 //!   convex particles;
 //! - [`mesh_io`]: STL and OBJ loading with checks that name the offending facet;
+//! - [`Polytope`]: a convex polytope cut by half-spaces, closed by construction;
 //! - [`gjk`]: intersection test and separation distance;
 //! - [`overlap`]: exact overlap volume, centroid and contact-area vector of two
 //!   convex polyhedra;
@@ -34,6 +35,9 @@ pub mod overlap;
 mod plane;
 pub(crate) mod polygon;
 mod polyhedron;
+mod polytope;
+#[cfg(test)]
+mod polytope_tests;
 pub mod quadrature;
 mod rotation;
 pub mod section;
@@ -51,6 +55,7 @@ pub use mass::{MassProperties, is_isotropic};
 pub use plane::Plane;
 pub(crate) use polygon::vector_area;
 pub use polyhedron::ConvexPolyhedron;
+pub use polytope::Polytope;
 pub use rotation::unit_quaternion;
 pub use shape::{Shape, Sphere};
 pub use spec::ShapeSpec;

@@ -16,8 +16,10 @@
 //! half-space `a · (x − base) ≥ gap/2` above the base and the inside of the regular
 //! polygon of [`WALL_SIDES`] sides inscribed in the circle `R − gap/2` about the
 //! axis (only the sides it reaches cut it).
-//! A capped particle is the convex hull of its kept vertices and the points where
-//! its edges cross the plane: closed, convex, and gap-separated from every other.
+//! Each half-space cuts the particle's faces in turn ([`Polytope::cut`]: one
+//! crossing point per cut edge, the open loop closed by a new face), so a capped
+//! particle is closed, convex and gap-separated from every other however thin the
+//! slivers the wall's many sides shave off it.
 
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -31,7 +33,7 @@ use crate::geometry::generators::icosphere_mesh;
 use crate::geometry::gjk::{GjkResult, gjk};
 use crate::geometry::overlap::overlap;
 use crate::geometry::polygon::{clip_by_plane, vector_area};
-use crate::geometry::{ConvexPolyhedron, GeometryError, Plane, Shape};
+use crate::geometry::{ConvexPolyhedron, GeometryError, Plane, Polytope, Shape};
 use crate::world::World;
 
 /// Icosphere level of a sphere in `bed.stl` and the caps (320 facets).
@@ -219,36 +221,6 @@ pub struct CappedParticle {
     pub triangles: Vec<[u32; 3]>,
 }
 
-/// Cuts `poly` (placed by `pose`) to the half-space; `None` if nothing is cut off.
-fn cut(
-    poly: &ConvexPolyhedron,
-    pose: &Isometry3<Real>,
-    keep: &Keep,
-) -> Result<Option<ConvexPolyhedron>, GeometryError> {
-    let world: Vec<Point3<Real>> = poly.vertices().iter().map(|v| pose * v).collect();
-    let side: Vec<Real> = world
-        .iter()
-        .map(|x| keep.normal.dot(&x.coords) - keep.offset)
-        .collect();
-    if side.iter().all(|&s| s <= 0.0) {
-        return Ok(None);
-    }
-    let mut points: Vec<Point3<Real>> = world
-        .iter()
-        .zip(&side)
-        .filter(|(_, s)| **s <= 0.0)
-        .map(|(x, _)| *x)
-        .collect();
-    for &[u, v] in poly.edges() {
-        let (su, sv) = (side[u as usize], side[v as usize]);
-        if (su > 0.0) != (sv > 0.0) {
-            let t = su / (su - sv);
-            points.push(world[u as usize] + (world[v as usize] - world[u as usize]) * t);
-        }
-    }
-    ConvexPolyhedron::from_hull(&points).map(Some)
-}
-
 /// Every particle capped against `contacts` (the [`bed_contacts`] closer than
 /// `gap`) and against the tube (see the module docs), in particle order.
 pub fn capped_particles(
@@ -296,35 +268,26 @@ pub fn capped_particles(
     let mut capped = Vec::with_capacity(p.owned());
     for (i, keeps) in keeps.iter().enumerate() {
         let template = &templates[p.body_type[i] as usize];
-        let (mut poly, mut pose) = ((**template).clone(), placement(world, &templates, i));
+        let mut poly = Polytope::placed(template, &placement(world, &templates, i));
         for keep in keeps.iter().chain([&floor]) {
-            if let Some(next) = cut(&poly, &pose, keep)? {
-                pose = *next.body_to_input();
-                poly = next;
-            }
+            poly.cut(&keep.normal, keep.offset)?;
         }
         // Against the curved wall: the sides of the regular polygon of
         // `WALL_SIDES` sides inscribed in the wall's cap that the particle reaches.
         let reach = poly
             .vertices()
             .iter()
-            .map(|v| radial(&(pose * v)).norm())
+            .map(|v| radial(v).norm())
             .fold(0.0, Real::max);
         if reach > apothem {
             for normal in &wall_normals {
-                let keep = Keep {
-                    normal: *normal,
-                    offset: normal.dot(&tube.base.coords) + apothem,
-                };
-                if let Some(next) = cut(&poly, &pose, &keep)? {
-                    pose = *next.body_to_input();
-                    poly = next;
-                }
+                poly.cut(normal, normal.dot(&tube.base.coords) + apothem)?;
             }
         }
+        let (vertices, triangles) = poly.triangulate();
         capped.push(CappedParticle {
-            vertices: poly.vertices().iter().map(|v| pose * v).collect(),
-            triangles: poly.triangles(),
+            vertices,
+            triangles,
         });
     }
     Ok(capped)

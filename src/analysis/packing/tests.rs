@@ -4,7 +4,7 @@ use crate::fluid::{CylindricalGrid, DragLaw, FluidGrid, FluidProperties, ShapeCo
 use crate::geometry::generators::cuboid;
 use crate::geometry::{ConvexPolyhedron, Sphere};
 use crate::world::{BodyType, DragModel, FluidField};
-use nalgebra::UnitQuaternion;
+use nalgebra::{Translation3, UnitQuaternion};
 use std::f64::consts::PI;
 use std::sync::Arc;
 
@@ -374,33 +374,7 @@ fn capped_spheres_are_closed_and_a_gap_apart() {
     let ball = ConvexPolyhedron::from_convex_mesh(&ball).unwrap().volume();
     let mut hulls = Vec::new();
     for (k, c) in capped.iter().enumerate() {
-        // Closed and consistently oriented: each directed edge once, and its twin.
-        let mut edges = std::collections::HashMap::new();
-        for t in &c.triangles {
-            for e in 0..3 {
-                *edges.entry((t[e], t[(e + 1) % 3])).or_insert(0) += 1;
-            }
-        }
-        for (&(u, v), &count) in &edges {
-            assert_eq!(count, 1, "particle {k}: edge {u}-{v} twice");
-            assert_eq!(
-                edges.get(&(v, u)),
-                Some(&1),
-                "particle {k}: edge {u}-{v} open"
-            );
-        }
-        for x in &c.vertices {
-            let r = x - t.base;
-            assert!(
-                r.z >= 0.5 * gap - 1e-12,
-                "particle {k} below the floor's cap"
-            );
-            let beyond = r.xy().norm() - (1.5 - 0.5 * gap);
-            assert!(
-                beyond <= 1e-12,
-                "particle {k} in the wall's cap by {beyond}"
-            );
-        }
+        assert_closed_inside_caps(c, &t, gap, k);
         let hull = ConvexPolyhedron::from_hull(&c.vertices).unwrap();
         assert!(
             hull.volume() > 0.9 * ball,
@@ -502,4 +476,104 @@ fn the_porosity_map_holds_both_profiles_and_takes_a_cylindrical_fluid_grid() {
         .map(|c| (1.0 - map.porosity[c]) * map.grid.cell_volume(c))
         .sum();
     assert!((v / cuboids - 1.0).abs() < 1e-12, "{v} against {cuboids}");
+}
+
+/// A capped particle `k` is closed and consistently oriented (each directed edge
+/// of its triangles once, and its twin), above the floor's cap and inside the wall's.
+fn assert_closed_inside_caps(c: &super::mesher::CappedParticle, t: &Tube, gap: Real, k: usize) {
+    let mut edges = std::collections::HashMap::new();
+    for t in &c.triangles {
+        for e in 0..3 {
+            *edges.entry((t[e], t[(e + 1) % 3])).or_insert(0) += 1;
+        }
+    }
+    for (&(u, v), &count) in &edges {
+        assert_eq!(count, 1, "particle {k}: edge {u}-{v} twice");
+        assert_eq!(
+            edges.get(&(v, u)),
+            Some(&1),
+            "particle {k}: edge {u}-{v} open"
+        );
+    }
+    let scale = 1e-12 * t.radius;
+    for x in &c.vertices {
+        let r = x - t.base;
+        let height = t.axis.normalize().dot(&r);
+        assert!(
+            height >= 0.5 * gap - scale,
+            "particle {k} below the floor's cap"
+        );
+        let beyond = (r - t.axis.normalize() * height).norm() - (t.radius - 0.5 * gap);
+        assert!(
+            beyond <= scale,
+            "particle {k} in the wall's cap by {beyond}"
+        );
+    }
+}
+
+/// Enclosed volume of a capped particle's triangles.
+fn enclosed_volume(c: &super::mesher::CappedParticle) -> Real {
+    c.triangles
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|v| c.vertices[v as usize] - c.vertices[0]);
+            a.dot(&b.cross(&c))
+        })
+        .sum::<Real>()
+        / 6.0
+}
+
+/// The fixed-bed example's pellets (20-sided prisms, D = L = 5.5 mm, tube R =
+/// 12.5 mm) in 500 random orientations and places against the wall, capped: the
+/// wall's 720-gon cap shaves each with up to dozens of slivers. Capping by the hull
+/// of the kept points failed for about one pellet in 80 (faces oriented
+/// inconsistently); now every one is closed, inside the caps, and its volume is
+/// that of the pellet's exact overlap with the 720-gon prism of the cap.
+#[test]
+fn capped_pellets_at_the_wall_are_closed_and_exact() {
+    use super::mesher::{WALL_SIDES, capped_particles};
+    use crate::geometry::generators::prism;
+    use crate::geometry::overlap::overlap;
+    use rand::{Rng, SeedableRng};
+    let t = Tube {
+        base: Point3::origin(),
+        axis: Vector3::z(),
+        radius: 0.0125,
+    };
+    let gap = 5.5e-5;
+    let pellet = prism(20, 5.5e-3, 5.5e-3).unwrap();
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(3);
+    let placements: Vec<_> = (0..500)
+        .map(|_| {
+            let turn = Vector3::from_fn(|_, _| rng.random_range(-PI..PI));
+            let phi = rng.random_range(0.0..2.0 * PI);
+            let rho = t.radius - 3.0e-3 + rng.random_range(-2e-4..2e-4);
+            let x = Point3::new(rho * phi.cos(), rho * phi.sin(), 0.01);
+            (x, UnitQuaternion::from_scaled_axis(turn))
+        })
+        .collect();
+    let world = world_of(Shape::Polyhedron(Arc::new(pellet.clone())), &placements);
+    let capped = capped_particles(&world, &t, gap, &[]).unwrap();
+    // The wall's cap as a prism: its sides face the angles 2πk/720 (a vertex of
+    // `prism` at angle 0, turned half a side), centred on the pellets' height.
+    let cap = prism(WALL_SIDES, 2.0 * (t.radius - 0.5 * gap), 0.02).unwrap();
+    let cap_pose = Isometry3::from_parts(
+        Translation3::new(0.0, 0.0, 0.01),
+        UnitQuaternion::from_axis_angle(&Vector3::z_axis(), PI / WALL_SIDES as Real),
+    ) * cap.body_to_input();
+    let mut shaved = 0;
+    for (k, (c, (x, q))) in capped.iter().zip(&placements).enumerate() {
+        assert_closed_inside_caps(c, &t, gap, k);
+        let pose = Isometry3::from_parts(Translation3::from(x.coords), *q);
+        let exact = overlap(&cap, &pellet, &(cap_pose.inverse() * pose))
+            .unwrap()
+            .volume;
+        let volume = enclosed_volume(c);
+        assert!(
+            (volume / exact - 1.0).abs() < 1e-12,
+            "pellet {k}: {volume} against {exact}"
+        );
+        shaved += usize::from(volume < pellet.volume() * (1.0 - 1e-9));
+    }
+    assert!(shaved > 200, "only {shaved} pellets reach the wall's cap");
 }
