@@ -37,6 +37,7 @@ use nalgebra::{Point3, Unit, Vector3};
 use super::Tube;
 use super::mesher::{BedContact, placement, templates};
 use crate::Real;
+use crate::geometry::surfaces::tangent_frame;
 use crate::geometry::{ConvexPolyhedron, GeometryError};
 use crate::world::World;
 
@@ -76,7 +77,7 @@ impl Bridge {
     /// The prism's vertices: the ring about `start`, then the ring about `end`.
     pub fn vertices(&self) -> Vec<Point3<Real>> {
         let axis = Unit::new_normalize(self.end - self.start);
-        let (e1, e2) = across(&axis);
+        let (e1, e2) = tangent_frame(&axis);
         let ring = |centre: Point3<Real>| {
             (0..BRIDGE_SIDES).map(move |k| {
                 let angle = 2.0 * PI * k as Real / BRIDGE_SIDES as Real;
@@ -102,17 +103,6 @@ impl Bridge {
         }
         (self.vertices(), triangles)
     }
-}
-
-/// Two unit vectors completing `axis` to a right-handed frame.
-fn across(axis: &Unit<Vector3<Real>>) -> (Vector3<Real>, Vector3<Real>) {
-    let helper = if axis.x.abs() < 0.9 {
-        Vector3::x()
-    } else {
-        Vector3::y()
-    };
-    let e1 = axis.cross(&helper).normalize();
-    (e1, axis.cross(&e1))
 }
 
 /// How far from `from` along `inward` the circle of `radius` about the axis (and

@@ -24,7 +24,7 @@
 use std::collections::HashMap;
 use std::sync::Arc;
 
-use nalgebra::{Isometry3, Point3, Vector3};
+use nalgebra::{Isometry3, Point3, Unit, Vector3};
 
 use super::Tube;
 use super::near::near_pairs;
@@ -33,6 +33,7 @@ use crate::geometry::generators::icosphere_mesh;
 use crate::geometry::gjk::{GjkResult, gjk};
 use crate::geometry::overlap::overlap;
 use crate::geometry::polygon::{clip_by_plane, vector_area};
+use crate::geometry::surfaces::tangent_frame;
 use crate::geometry::{ConvexPolyhedron, GeometryError, Plane, Polytope, Shape};
 use crate::world::World;
 
@@ -250,11 +251,7 @@ pub fn capped_particles(
     };
     // The wall's cap: a polygon inscribed in the circle `R − gap/2`.
     let apothem = (tube.radius - 0.5 * gap) * (std::f64::consts::PI / WALL_SIDES as Real).cos();
-    let e1 = axis
-        .cross(&Vector3::x())
-        .try_normalize(1e-6)
-        .unwrap_or_else(|| axis.cross(&Vector3::y()).normalize());
-    let e2 = axis.cross(&e1);
+    let (e1, e2) = tangent_frame(&Unit::new_normalize(axis));
     let wall_normals: Vec<Vector3<Real>> = (0..WALL_SIDES)
         .map(|k| {
             let angle = 2.0 * std::f64::consts::PI * k as Real / WALL_SIDES as Real;
