@@ -6,8 +6,9 @@
 //! back ([`stats`]: counts, energies, time per stage), the rigid-body integrator
 //! ([`integrate`]), the broad phase ([`broad_phase`]), the Verlet lists built from it
 //! ([`neighbours`]), the contact parameters of every pair of body types (`laws`) and
-//! the suggested time step ([`time_step`]), and the split of space among ranks
-//! ([`decomposition`]). Every stage is written the way a GPU
+//! the suggested time step ([`time_step`]); for a run split among ranks, the split
+//! of space ([`decomposition`]), how ranks talk ([`exchange`]) and one rank's step
+//! ([`rank`]). Every stage is written the way a GPU
 //! kernel is: a data-parallel loop over particles or candidate pairs reading flat
 //! arrays and writing its own slot; each particle then gathers its pairs' forces in
 //! pair order, so results do not depend on the number of threads.
@@ -18,11 +19,13 @@ pub mod cpu;
 pub mod decomposition;
 #[cfg(test)]
 mod decomposition_tests;
+pub mod exchange;
 mod fast_hash;
 pub mod integrate;
 mod laws;
 pub mod neighbours;
 pub mod params;
+pub mod rank;
 pub mod stats;
 pub mod time_step;
 

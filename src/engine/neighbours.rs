@@ -159,9 +159,7 @@ impl NeighbourList {
     pub fn build(&mut self, world: &World, radii: &[Real]) {
         let p = &world.particles;
         let n = p.len();
-        let skin = self.skin.unwrap_or_else(|| {
-            DEFAULT_SKIN * radii.iter().copied().fold(Real::INFINITY, Real::min)
-        });
+        let skin = self.skin.unwrap_or_else(|| automatic_skin(radii));
         let skin = if skin.is_finite() { skin.max(0.0) } else { 0.0 };
         self.built_skin = skin;
 
@@ -239,6 +237,13 @@ impl NeighbourList {
 /// sorts the pairs by `(id[i], id[j])`. Where the ids ascend with the index
 /// (particles stored in the order of their ids) that is the order of the indices,
 /// and sorted as such.
+/// The skin when none is set: [`DEFAULT_SKIN`] times the smallest of the bounding
+/// `radii` (0 for none).
+pub fn automatic_skin(radii: &[Real]) -> Real {
+    let skin = DEFAULT_SKIN * radii.iter().copied().fold(Real::INFINITY, Real::min);
+    if skin.is_finite() { skin.max(0.0) } else { 0.0 }
+}
+
 fn sort_by_ids(pairs: &mut [[u32; 2]], id: &[u64]) {
     if id.is_sorted() {
         pairs.par_sort_unstable();

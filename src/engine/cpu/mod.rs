@@ -79,6 +79,29 @@ impl CpuBackend {
         &self.list
     }
 
+    /// The first part of a step: the opening half kick and the drift of the owned
+    /// particles, and the walls moved to the step's end. A driver that shares
+    /// particles with other ranks refreshes their ghost copies here, before
+    /// [`Self::forces`] (`step` is `drift`, `forces`, `close`).
+    pub fn drift(&mut self, world: &mut World, dt: Real) {
+        self.stats.integrated = self
+            .times
+            .time(Stage::Integrate, || motion::kick_drift(world, dt));
+        self.times
+            .time(Stage::WallMotion, || motion::advance_walls(world, dt));
+    }
+
+    /// The forces of the step (the lists rebuilt first if they are stale).
+    pub fn forces(&mut self, world: &mut World, dt: Real) {
+        self.evaluate_forces(world, dt, true);
+    }
+
+    /// The closing half kick of the owned particles.
+    pub fn close(&mut self, world: &mut World, dt: Real) {
+        self.times
+            .time(Stage::Integrate, || motion::closing_kick(world, dt));
+    }
+
     /// Forces and torques of the current positions and velocities, stage by stage.
     /// A step's evaluation (`stepped`) also counts the fluid's exchange over `dt`;
     /// the one of `initialise` only sets the forces.
@@ -189,15 +212,9 @@ impl Backend for CpuBackend {
 
     /// One velocity-Verlet step: the stages in order.
     fn step(&mut self, world: &mut World, dt: Real) {
-        let integrated = self
-            .times
-            .time(Stage::Integrate, || motion::kick_drift(world, dt));
-        self.times
-            .time(Stage::WallMotion, || motion::advance_walls(world, dt));
-        self.evaluate_forces(world, dt, true);
-        self.times
-            .time(Stage::Integrate, || motion::closing_kick(world, dt));
-        self.stats.integrated = integrated;
+        self.drift(world, dt);
+        self.forces(world, dt);
+        self.close(world, dt);
     }
 
     fn stats(&self) -> &StepStats {

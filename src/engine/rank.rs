@@ -1,0 +1,289 @@
+//! One rank of a decomposed run: it owns the particles whose centroids lie in its
+//! box of a [`Decomposition`], holds ghost copies of the others' particles within
+//! reach, and steps its share with a [`CpuBackend`] so that every particle moves
+//! to the same bits as in one process.
+//!
+//! **A step.** The opening kick and drift of the owned particles; the ghosts'
+//! states refreshed from their owners; if any rank's lists are stale (one answer
+//! for all, as one process would decide), the renewal: particles whose centroid
+//! left the box move to their new owner with their contact history, and the ghosts
+//! are chosen again; then the forces (the lists rebuilt where renewed) and the
+//! closing kick. Ghosts are copied bit for bit, each pair is evaluated the same way
+//! round on every rank that holds it (the neighbour lists orient and sort pairs by
+//! particle id), and each particle gathers its pairs in id order, so an owned
+//! particle's force is the one-process force to the bit.
+//!
+//! **History.** A pair's tangential history lives on every rank that holds the
+//! pair with one of its particles owned there, computed identically on each; at a
+//! renewal a leaving particle takes the history of its pairs and its wall patches
+//! with it, and what it brings overrides the new rank's copy (a pair of two ghosts
+//! is not evaluated, so that copy may be stale).
+
+use std::collections::BTreeMap;
+
+use nalgebra::{Point3, UnitQuaternion, Vector3};
+
+use super::backend::{Backend, ContactHistory};
+use super::cpu::CpuBackend;
+use super::decomposition::Decomposition;
+use super::exchange::Exchange;
+use super::neighbours::automatic_skin;
+use super::params::StepParams;
+use crate::Real;
+use crate::world::{Particles, World};
+
+/// A particle's state as it travels between ranks.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ParticleRecord {
+    /// Stable id.
+    pub id: u64,
+    /// Body type index.
+    pub body_type: u32,
+    /// Frozen (part of a bed at rest).
+    pub frozen: bool,
+    /// Centroid.
+    pub position: Point3<Real>,
+    /// Orientation.
+    pub orientation: UnitQuaternion<Real>,
+    /// Linear velocity.
+    pub velocity: Vector3<Real>,
+    /// Angular momentum (world frame).
+    pub angular_momentum: Vector3<Real>,
+}
+
+impl ParticleRecord {
+    fn of(p: &Particles, i: usize) -> Self {
+        ParticleRecord {
+            id: p.id[i],
+            body_type: p.body_type[i],
+            frozen: p.frozen[i],
+            position: p.position[i],
+            orientation: p.orientation[i],
+            velocity: p.velocity[i],
+            angular_momentum: p.angular_momentum[i],
+        }
+    }
+
+    /// Writes the motion state into entry `i`.
+    fn set_motion(&self, p: &mut Particles, i: usize) {
+        p.position[i] = self.position;
+        p.orientation[i] = self.orientation;
+        p.velocity[i] = self.velocity;
+        p.angular_momentum[i] = self.angular_momentum;
+    }
+}
+
+/// A particle changing owner, with the history of its pairs and wall patches.
+#[derive(Clone, Debug)]
+struct Migrant {
+    particle: ParticleRecord,
+    history: ContactHistory,
+}
+
+/// Steps one rank's share of a decomposed world.
+///
+/// Invariant: the world holds the owned particles (centroid in this rank's box at
+/// the last renewal) first, then the ghosts in the order of `sends` of the ranks
+/// before and after this one (rank order, then the sender's order).
+#[derive(Debug)]
+pub struct RankStepper<E: Exchange> {
+    exchange: E,
+    decomposition: Decomposition,
+    reach: Real,
+    backend: CpuBackend,
+    /// For each rank, the owned particles copied there as ghosts.
+    sends: Vec<Vec<usize>>,
+    migrated: usize,
+    renewals: usize,
+}
+
+impl<E: Exchange> RankStepper<E> {
+    /// Takes this rank's share of `world` (every rank passes the same world and
+    /// decomposition): keeps the particles it owns, adds the ghosts within reach
+    /// (twice the largest bounding radius of a body type plus the skin), and
+    /// evaluates the forces for a first step of `dt`. An automatic skin is fixed
+    /// here from the whole world's particles, as one process would choose it.
+    pub fn new(
+        exchange: E,
+        decomposition: Decomposition,
+        mut params: StepParams,
+        world: &mut World,
+        dt: Real,
+    ) -> Self {
+        assert_eq!(exchange.size(), decomposition.ranks(), "one box per rank");
+        let radius = |k: &u32| world.body_types[*k as usize].shape.circumradius();
+        let radii: Vec<Real> = world.particles.body_type.iter().map(radius).collect();
+        let skin = *params.skin.get_or_insert_with(|| automatic_skin(&radii));
+        let largest = world
+            .body_types
+            .iter()
+            .map(|t| t.shape.circumradius())
+            .fold(0.0, Real::max);
+        let reach = 2.0 * largest + skin;
+        let me = exchange.rank();
+        world.particles.clear_ghosts();
+        let positions = world.particles.position.clone();
+        world
+            .particles
+            .remove_where(|i| decomposition.owner(&positions[i]) != me);
+        let mut rank = RankStepper {
+            sends: vec![Vec::new(); exchange.size()],
+            exchange,
+            decomposition,
+            reach,
+            backend: CpuBackend::new(params),
+            migrated: 0,
+            renewals: 0,
+        };
+        rank.choose_ghosts(world);
+        rank.backend.initialise(world, dt);
+        rank
+    }
+
+    /// The backend (figures and lists of this rank's share).
+    pub fn backend(&self) -> &CpuBackend {
+        &self.backend
+    }
+
+    /// How far from its box a particle is copied as a ghost.
+    pub fn reach(&self) -> Real {
+        self.reach
+    }
+
+    /// Particles that arrived here from other ranks so far.
+    pub fn migrated(&self) -> usize {
+        self.migrated
+    }
+
+    /// List renewals so far (the same on every rank).
+    pub fn renewals(&self) -> usize {
+        self.renewals
+    }
+
+    /// One step of length `dt` (every rank calls it together).
+    pub fn step(&mut self, world: &mut World, dt: Real) {
+        self.backend.drift(world, dt);
+        self.refresh_ghosts(world);
+        let stale = self.exchange.any(self.backend.neighbours().is_stale(world));
+        if stale {
+            self.renew(world);
+        }
+        self.backend.forces(world, dt);
+        self.backend.close(world, dt);
+    }
+
+    /// Copies the owned particles' states to the ranks where they are ghosts.
+    fn refresh_ghosts(&mut self, world: &mut World) {
+        let p = &world.particles;
+        let outgoing = self
+            .sends
+            .iter()
+            .map(|list| list.iter().map(|&i| ParticleRecord::of(p, i)).collect())
+            .collect();
+        let received: Vec<Vec<ParticleRecord>> = self.exchange.all_to_all(outgoing);
+        let p = &mut world.particles;
+        for (k, record) in received.iter().flatten().enumerate() {
+            record.set_motion(p, p.owned() + k);
+        }
+    }
+
+    /// Moves the particles that left the box to their owners, with their history,
+    /// and chooses the ghosts again.
+    fn renew(&mut self, world: &mut World) {
+        self.renewals += 1;
+        let me = self.exchange.rank();
+        let mut history = self.backend.contact_history();
+        let p = &world.particles;
+        let owned_here = |id: u64| p.index_of(id).is_some_and(|i| !p.is_ghost(i));
+        history
+            .pairs
+            .retain(|((a, b), _)| owned_here(*a) || owned_here(*b));
+        let mut outgoing: Vec<Vec<Migrant>> = vec![Vec::new(); self.exchange.size()];
+        let owners: Vec<usize> = (0..p.owned())
+            .map(|i| self.decomposition.owner(&p.position[i]))
+            .collect();
+        let leaving = |i: usize| owners.get(i).is_some_and(|&o| o != me);
+        let mut gone = Vec::new();
+        for (i, &owner) in owners.iter().enumerate().filter(|&(i, _)| leaving(i)) {
+            gone.push(p.id[i]);
+            outgoing[owner].push(Migrant {
+                particle: ParticleRecord::of(p, i),
+                history: history_of(&history, p.id[i]),
+            });
+        }
+        history.walls.retain(|(key, _)| !gone.contains(&key.0));
+        world.particles.clear_ghosts();
+        world.particles.remove_where(leaving);
+
+        let arrived: Vec<Vec<Migrant>> = self.exchange.all_to_all(outgoing);
+        let mut pairs: BTreeMap<_, _> = history.pairs.into_iter().collect();
+        let mut walls: BTreeMap<_, _> = history.walls.into_iter().collect();
+        for m in arrived.into_iter().flatten() {
+            let r = &m.particle;
+            let p = &mut world.particles;
+            p.push(r.body_type, r.position, r.orientation, r.id);
+            let i = p.owned() - 1;
+            r.set_motion(p, i);
+            p.frozen[i] = r.frozen;
+            pairs.extend(m.history.pairs);
+            walls.extend(m.history.walls);
+            self.migrated += 1;
+        }
+        self.choose_ghosts(world);
+        let stats = *self.backend.stats();
+        let history = ContactHistory {
+            pairs: pairs.into_iter().collect(),
+            walls: walls.into_iter().collect(),
+        };
+        // The history is matched to the pairs when the lists are built again.
+        self.backend.restore(world, history, stats);
+    }
+
+    /// Sends copies of the owned particles within reach of other boxes there and
+    /// appends the copies received as ghosts.
+    fn choose_ghosts(&mut self, world: &mut World) {
+        let me = self.exchange.rank();
+        let p = &world.particles;
+        for list in &mut self.sends {
+            list.clear();
+        }
+        for i in 0..p.owned() {
+            for r in self
+                .decomposition
+                .ghost_ranks(&p.position[i], me, self.reach)
+            {
+                self.sends[r].push(i);
+            }
+        }
+        let outgoing = self
+            .sends
+            .iter()
+            .map(|list| list.iter().map(|&i| ParticleRecord::of(p, i)).collect())
+            .collect();
+        let received: Vec<Vec<ParticleRecord>> = self.exchange.all_to_all(outgoing);
+        let p = &mut world.particles;
+        for r in received.iter().flatten() {
+            p.push_ghost(r.body_type, r.position, r.orientation, r.id);
+            let i = p.len() - 1;
+            r.set_motion(p, i);
+        }
+    }
+}
+
+/// The entries of `history` that concern particle `id`.
+fn history_of(history: &ContactHistory, id: u64) -> ContactHistory {
+    ContactHistory {
+        pairs: history
+            .pairs
+            .iter()
+            .filter(|((a, b), _)| *a == id || *b == id)
+            .copied()
+            .collect(),
+        walls: history
+            .walls
+            .iter()
+            .filter(|(key, _)| key.0 == id)
+            .copied()
+            .collect(),
+    }
+}
