@@ -1,0 +1,205 @@
+//! A world split among ranks (threads talking through a `ThreadExchange`) moves
+//! every particle to the same bits as one process: the ranks own the particles in
+//! their boxes, copy those within reach to each other as ghosts, renew their lists
+//! when one process would, and hand particles that cross a box's face over with
+//! their contact history.
+
+use std::ops::ControlFlow;
+use std::path::Path;
+
+use nalgebra::{Point3, Vector3};
+use rand::{Rng, SeedableRng};
+use talus::Real;
+use talus::engine::decomposition::Decomposition;
+use talus::engine::exchange::ThreadExchange;
+use talus::engine::rank::RankStepper;
+use talus::engine::{Backend, CpuBackend, StepParams};
+use talus::scene::{Scene, Simulation};
+use talus::world::World;
+
+/// The world of example `name` (with `overrides` appended) run to `until`, its step
+/// parameters and step.
+fn example_at(name: &str, overrides: &str, until: Real) -> (World, StepParams, Real) {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(name);
+    let text = std::fs::read_to_string(&path).unwrap() + overrides;
+    let scene = Scene::parse(&text, &path).unwrap();
+    let mut sim = Simulation::new(&scene);
+    let _ = sim.advance_to(until, |_, _| ControlFlow::<()>::Continue(()));
+    (sim.world().clone(), sim.params(), sim.dt())
+}
+
+/// Random sideways velocities up to `speed`.
+fn shake(world: &mut World, speed: Real, seed: u64) {
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
+    let p = &mut world.particles;
+    for i in 0..p.len() {
+        if !p.frozen[i] {
+            p.velocity[i].x = rng.random_range(-speed..speed);
+            p.velocity[i].y = rng.random_range(-speed..speed);
+        }
+    }
+}
+
+/// Boxes of `ranks` bisected at the centroids with equal cost.
+fn boxes(world: &World, ranks: usize) -> Decomposition {
+    let p = &world.particles;
+    Decomposition::bisect(&p.position, &vec![1.0; p.len()], ranks)
+}
+
+/// What a rank ends with: its world, particles that arrived, renewals.
+type RankEnd = (World, usize, usize);
+
+/// Steps `start` `steps` times in one process and on the ranks of each layout;
+/// checks every particle owned once with the one-process state to the bit, the
+/// renewals at the one-process list builds, and each wall's force and torque
+/// summed over the ranks within 1e-12; returns what each rank of each layout ended
+/// with.
+fn same_motion_on_ranks(
+    start: &World,
+    params: StepParams,
+    dt: Real,
+    steps: usize,
+    layouts: &[Decomposition],
+) -> Vec<Vec<RankEnd>> {
+    let mut whole = start.clone();
+    let mut one = CpuBackend::new(params);
+    one.initialise(&mut whole, dt);
+    for _ in 0..steps {
+        one.step(&mut whole, dt);
+    }
+    let q = &whole.particles;
+    let mut ends = Vec::new();
+    for layout in layouts {
+        let ranks = layout.ranks();
+        let results: Vec<RankEnd> = std::thread::scope(|s| {
+            let handles: Vec<_> = ThreadExchange::group(ranks)
+                .into_iter()
+                .map(|exchange| {
+                    let (layout, mut world) = (layout.clone(), start.clone());
+                    s.spawn(move || {
+                        let mut rank = RankStepper::new(exchange, layout, params, &mut world, dt);
+                        for _ in 0..steps {
+                            rank.step(&mut world, dt);
+                        }
+                        (world, rank.migrated(), rank.renewals())
+                    })
+                })
+                .collect();
+            handles.into_iter().map(|h| h.join().unwrap()).collect()
+        });
+        let mut seen = 0;
+        for (w, _, renewals) in &results {
+            // The first list is built at the start, the others at renewals.
+            assert_eq!(
+                *renewals as u64 + 1,
+                one.neighbours().builds(),
+                "{ranks} ranks"
+            );
+            let p = &w.particles;
+            for i in 0..p.owned() {
+                let j = q.index_of(p.id[i]).unwrap();
+                let id = p.id[i];
+                assert_eq!(p.position[i], q.position[j], "{ranks} ranks: particle {id}");
+                assert_eq!(p.orientation[i], q.orientation[j], "{ranks} ranks: {id}");
+                assert_eq!(p.velocity[i], q.velocity[j], "{ranks} ranks: {id}");
+                assert_eq!(
+                    p.angular_momentum[i], q.angular_momentum[j],
+                    "{ranks} ranks"
+                );
+                assert_eq!(p.frozen[i], q.frozen[j]);
+                seen += 1;
+            }
+        }
+        assert_eq!(seen, q.len(), "{ranks} ranks: every particle owned once");
+        for (k, wall) in whole.walls.iter().enumerate() {
+            let force: Vector3<Real> = results.iter().map(|r| r.0.walls[k].force).sum();
+            let torque: Vector3<Real> = results.iter().map(|r| r.0.walls[k].torque).sum();
+            let close =
+                |a: Vector3<Real>, b: Vector3<Real>| (a - b).norm() <= 1e-12 * b.norm().max(1e-300);
+            assert!(
+                close(force, wall.force),
+                "{ranks} ranks: {force} for {}",
+                wall.force
+            );
+            assert!(
+                close(torque, wall.torque),
+                "{ranks} ranks: {torque} for {}",
+                wall.torque
+            );
+        }
+        ends.push(results);
+    }
+    ends
+}
+
+fn migrated(ends: &[RankEnd]) -> usize {
+    ends.iter().map(|e| e.1).sum()
+}
+
+#[test]
+fn a_shaken_box_of_polyhedra_moves_alike_on_two_three_and_four_ranks() {
+    let (mut world, params, dt) = example_at("examples/settling_box/scene.toml", "", 0.1);
+    shake(&mut world, 1.0, 11);
+    let layouts: Vec<_> = (2..=4).map(|r| boxes(&world, r)).collect();
+    let ends = same_motion_on_ranks(&world, params, dt, 1500, &layouts);
+    for (layout, end) in layouts.iter().zip(&ends) {
+        let moved = migrated(end);
+        assert!(
+            moved >= 5,
+            "{} ranks: {moved} particles changed rank",
+            layout.ranks()
+        );
+    }
+}
+
+#[test]
+fn a_turning_drum_moves_alike_on_ranks() {
+    let (world, params, dt) = example_at("examples/drum/quasi2d.toml", "", 0.05);
+    let layouts = [boxes(&world, 2), boxes(&world, 3)];
+    let ends = same_motion_on_ranks(&world, params, dt, 1000, &layouts);
+    assert!(
+        migrated(&ends[1]) > 0,
+        "particles cross boxes in a turning drum"
+    );
+}
+
+/// The settled box with its lower half frozen (a bed) and the rest shaken; and the
+/// same on three ranks of which one owns nothing (its box holds only a heavy
+/// point far away).
+#[test]
+fn a_frozen_bed_and_an_empty_rank_move_alike() {
+    let (mut world, params, dt) = example_at("examples/settling_box/scene.toml", "", 0.1);
+    let mut heights: Vec<Real> = world.particles.position.iter().map(|x| x.z).collect();
+    heights.sort_by(Real::total_cmp);
+    let median = heights[heights.len() / 2];
+    for i in 0..world.particles.len() {
+        if world.particles.position[i].z < median {
+            world.particles.freeze(i);
+        }
+    }
+    assert!(world.particles.frozen_count() > 10);
+    shake(&mut world, 1.0, 12);
+    let n = world.particles.len();
+    let mut cloud = world.particles.position.clone();
+    cloud.push(Point3::new(100.0, 0.0, 0.0));
+    let mut cost = vec![1.0; n];
+    cost.push(n as Real);
+    let empty = Decomposition::bisect(&cloud, &cost, 3);
+    let layouts = [boxes(&world, 2), boxes(&world, 4), empty];
+    let ends = same_motion_on_ranks(&world, params, dt, 1000, &layouts);
+    assert!(
+        ends[2].iter().any(|e| e.0.particles.owned() == 0),
+        "one rank of three owns nothing"
+    );
+}
+
+#[test]
+fn hertz_spheres_rolling_elastic_plastic_move_alike_on_ranks() {
+    let (world, params, dt) = example_at(
+        "examples/fluid_bed/pour.toml",
+        "\n[contact]\nlaw = \"hertz_mindlin\"\nrolling = \"elastic_plastic\"\n",
+        0.14,
+    );
+    let ends = same_motion_on_ranks(&world, params, dt, 500, &[boxes(&world, 3)]);
+    assert_eq!(ends[0].len(), 3);
+}
