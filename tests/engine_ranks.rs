@@ -13,7 +13,7 @@ use talus::Real;
 use talus::engine::decomposition::Decomposition;
 use talus::engine::exchange::ThreadExchange;
 use talus::engine::rank::RankStepper;
-use talus::engine::{Backend, CpuBackend, StepParams};
+use talus::engine::{Backend, ContactHistory, CpuBackend, StepParams, StepStats};
 use talus::scene::{Scene, Simulation};
 use talus::world::World;
 
@@ -61,8 +61,28 @@ fn same_motion_on_ranks(
     steps: usize,
     layouts: &[Decomposition],
 ) -> Vec<Vec<RankEnd>> {
+    same_motion_from_history(
+        start,
+        &ContactHistory::default(),
+        params,
+        dt,
+        steps,
+        layouts,
+    )
+}
+
+/// [`same_motion_on_ranks`] from a restored state with its contact `history`.
+fn same_motion_from_history(
+    start: &World,
+    history: &ContactHistory,
+    params: StepParams,
+    dt: Real,
+    steps: usize,
+    layouts: &[Decomposition],
+) -> Vec<Vec<RankEnd>> {
     let mut whole = start.clone();
     let mut one = CpuBackend::new(params);
+    one.restore(&whole, history.clone(), StepStats::default());
     one.initialise(&mut whole, dt);
     for _ in 0..steps {
         one.step(&mut whole, dt);
@@ -77,7 +97,8 @@ fn same_motion_on_ranks(
                 .map(|exchange| {
                     let (layout, mut world) = (layout.clone(), start.clone());
                     s.spawn(move || {
-                        let mut rank = RankStepper::new(exchange, layout, params, &mut world, dt);
+                        let mut rank =
+                            RankStepper::new(exchange, layout, params, &mut world, history, dt);
                         for _ in 0..steps {
                             rank.step(&mut world, dt);
                         }
@@ -202,4 +223,37 @@ fn hertz_spheres_rolling_elastic_plastic_move_alike_on_ranks() {
     );
     let ends = same_motion_on_ranks(&world, params, dt, 500, &[boxes(&world, 3)]);
     assert_eq!(ends[0].len(), 3);
+}
+
+/// The shaken box stepped 300 steps in one process, then continued from its state
+/// and contact history: on ranks as in one process (and the history matters: the
+/// continuation without it differs).
+#[test]
+fn a_restored_state_continues_alike_on_ranks() {
+    let (mut world, params, dt) = example_at("examples/settling_box/scene.toml", "", 0.1);
+    shake(&mut world, 0.3, 13);
+    let mut one = CpuBackend::new(params);
+    one.initialise(&mut world, dt);
+    for _ in 0..300 {
+        one.step(&mut world, dt);
+    }
+    let history = one.contact_history();
+    assert!(history.pairs.len() > 20 && !history.walls.is_empty());
+    let layouts = [boxes(&world, 2), boxes(&world, 3)];
+    let ends = same_motion_from_history(&world, &history, params, dt, 500, &layouts);
+    let forgetful = same_motion_on_ranks(&world, params, dt, 500, &layouts[..1]);
+    let moved = |e: &[RankEnd]| {
+        let mut all: Vec<(u64, Point3<Real>)> = e
+            .iter()
+            .flat_map(|r| {
+                let p = &r.0.particles;
+                (0..p.owned())
+                    .map(|i| (p.id[i], p.position[i]))
+                    .collect::<Vec<_>>()
+            })
+            .collect();
+        all.sort_by_key(|a| a.0);
+        all
+    };
+    assert_ne!(moved(&ends[0]), moved(&forgetful[0]), "the history matters");
 }

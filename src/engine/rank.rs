@@ -101,13 +101,16 @@ impl<E: Exchange> RankStepper<E> {
     /// Takes this rank's share of `world` (every rank passes the same world and
     /// decomposition): keeps the particles it owns, adds the ghosts within reach
     /// (twice the largest bounding radius of a body type plus the skin), and
-    /// evaluates the forces for a first step of `dt`. An automatic skin is fixed
-    /// here from the whole world's particles, as one process would choose it.
+    /// evaluates the forces for a first step of `dt`. `history` is the whole run's
+    /// tangential history (of a restored state; empty for a fresh start): the rank
+    /// keeps what concerns its own particles. An automatic skin is fixed here from
+    /// the whole world's particles, as one process would choose it.
     pub fn new(
         exchange: E,
         decomposition: Decomposition,
         mut params: StepParams,
         world: &mut World,
+        history: &ContactHistory,
         dt: Real,
     ) -> Self {
         assert_eq!(exchange.size(), decomposition.ranks(), "one box per rank");
@@ -135,7 +138,24 @@ impl<E: Exchange> RankStepper<E> {
             migrated: 0,
             renewals: 0,
         };
+        let p = &world.particles;
+        let mine = ContactHistory {
+            pairs: history
+                .pairs
+                .iter()
+                .filter(|((a, b), _)| p.index_of(*a).is_some() || p.index_of(*b).is_some())
+                .copied()
+                .collect(),
+            walls: history
+                .walls
+                .iter()
+                .filter(|(key, _)| p.index_of(key.0).is_some())
+                .copied()
+                .collect(),
+        };
         rank.choose_ghosts(world);
+        let stats = *rank.backend.stats();
+        rank.backend.restore(world, mine, stats);
         rank.backend.initialise(world, dt);
         rank
     }
