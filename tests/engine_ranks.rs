@@ -46,8 +46,14 @@ fn boxes(world: &World, ranks: usize) -> Decomposition {
     Decomposition::bisect(&p.position, &vec![1.0; p.len()], ranks)
 }
 
-/// What a rank ends with: its world, particles that arrived, renewals.
-type RankEnd = (World, usize, usize);
+/// What a rank ends with.
+struct RankEnd {
+    world: World,
+    migrated: usize,
+    renewals: usize,
+    rebalances: usize,
+    imbalance: Real,
+}
 
 /// Steps `start` `steps` times in one process and on the ranks of each layout;
 /// checks every particle owned once with the one-process state to the bit, the
@@ -61,17 +67,12 @@ fn same_motion_on_ranks(
     steps: usize,
     layouts: &[Decomposition],
 ) -> Vec<Vec<RankEnd>> {
-    same_motion_from_history(
-        start,
-        &ContactHistory::default(),
-        params,
-        dt,
-        steps,
-        layouts,
-    )
+    let history = ContactHistory::default();
+    same_motion_from_history(start, &history, params, dt, steps, layouts, None)
 }
 
-/// [`same_motion_on_ranks`] from a restored state with its contact `history`.
+/// [`same_motion_on_ranks`] from a restored state with its contact `history`, the
+/// ranks rebalancing above the imbalance `rebalance`.
 fn same_motion_from_history(
     start: &World,
     history: &ContactHistory,
@@ -79,6 +80,7 @@ fn same_motion_from_history(
     dt: Real,
     steps: usize,
     layouts: &[Decomposition],
+    rebalance: Option<Real>,
 ) -> Vec<Vec<RankEnd>> {
     let mut whole = start.clone();
     let mut one = CpuBackend::new(params);
@@ -99,20 +101,30 @@ fn same_motion_from_history(
                     s.spawn(move || {
                         let mut rank =
                             RankStepper::new(exchange, layout, params, &mut world, history, dt);
+                        if let Some(threshold) = rebalance {
+                            rank = rank.rebalance_above(threshold);
+                        }
                         for _ in 0..steps {
                             rank.step(&mut world, dt);
                         }
-                        (world, rank.migrated(), rank.renewals())
+                        RankEnd {
+                            world,
+                            migrated: rank.migrated(),
+                            renewals: rank.renewals(),
+                            rebalances: rank.rebalances(),
+                            imbalance: rank.imbalance(),
+                        }
                     })
                 })
                 .collect();
             handles.into_iter().map(|h| h.join().unwrap()).collect()
         });
         let mut seen = 0;
-        for (w, _, renewals) in &results {
+        for end in &results {
+            let (w, renewals) = (&end.world, end.renewals);
             // The first list is built at the start, the others at renewals.
             assert_eq!(
-                *renewals as u64 + 1,
+                renewals as u64 + 1,
                 one.neighbours().builds(),
                 "{ranks} ranks"
             );
@@ -133,8 +145,8 @@ fn same_motion_from_history(
         }
         assert_eq!(seen, q.len(), "{ranks} ranks: every particle owned once");
         for (k, wall) in whole.walls.iter().enumerate() {
-            let force: Vector3<Real> = results.iter().map(|r| r.0.walls[k].force).sum();
-            let torque: Vector3<Real> = results.iter().map(|r| r.0.walls[k].torque).sum();
+            let force: Vector3<Real> = results.iter().map(|r| r.world.walls[k].force).sum();
+            let torque: Vector3<Real> = results.iter().map(|r| r.world.walls[k].torque).sum();
             let close =
                 |a: Vector3<Real>, b: Vector3<Real>| (a - b).norm() <= 1e-12 * b.norm().max(1e-300);
             assert!(
@@ -154,7 +166,7 @@ fn same_motion_from_history(
 }
 
 fn migrated(ends: &[RankEnd]) -> usize {
-    ends.iter().map(|e| e.1).sum()
+    ends.iter().map(|e| e.migrated).sum()
 }
 
 #[test]
@@ -209,7 +221,7 @@ fn a_frozen_bed_and_an_empty_rank_move_alike() {
     let layouts = [boxes(&world, 2), boxes(&world, 4), empty];
     let ends = same_motion_on_ranks(&world, params, dt, 1000, &layouts);
     assert!(
-        ends[2].iter().any(|e| e.0.particles.owned() == 0),
+        ends[2].iter().any(|e| e.world.particles.owned() == 0),
         "one rank of three owns nothing"
     );
 }
@@ -240,13 +252,13 @@ fn a_restored_state_continues_alike_on_ranks() {
     let history = one.contact_history();
     assert!(history.pairs.len() > 20 && !history.walls.is_empty());
     let layouts = [boxes(&world, 2), boxes(&world, 3)];
-    let ends = same_motion_from_history(&world, &history, params, dt, 500, &layouts);
+    let ends = same_motion_from_history(&world, &history, params, dt, 500, &layouts, None);
     let forgetful = same_motion_on_ranks(&world, params, dt, 500, &layouts[..1]);
     let moved = |e: &[RankEnd]| {
         let mut all: Vec<(u64, Point3<Real>)> = e
             .iter()
             .flat_map(|r| {
-                let p = &r.0.particles;
+                let p = &r.world.particles;
                 (0..p.owned())
                     .map(|i| (p.id[i], p.position[i]))
                     .collect::<Vec<_>>()
@@ -256,4 +268,40 @@ fn a_restored_state_continues_alike_on_ranks() {
         all
     };
     assert_ne!(moved(&ends[0]), moved(&forgetful[0]), "the history matters");
+}
+
+/// The shaken box on three ranks whose boxes start far off (one rank owns every
+/// particle) rebalances at its first renewal: the same motion as one process, and
+/// the imbalance (largest rank's cost over the mean, 3 at the start) comes down.
+#[test]
+fn ranks_rebalance_a_lopsided_split() {
+    let (mut world, params, dt) = example_at("examples/settling_box/scene.toml", "", 0.1);
+    shake(&mut world, 1.0, 14);
+    let far: Vec<Point3<Real>> = (0..3)
+        .map(|k| Point3::new(10.0 + k as Real, 0.0, 0.0))
+        .collect();
+    let lopsided = Decomposition::bisect(&far, &[1.0; 3], 3);
+    let n = world.particles.len();
+    let owners: Vec<usize> = world
+        .particles
+        .position
+        .iter()
+        .map(|x| lopsided.owner(x))
+        .collect();
+    assert!(
+        owners.iter().all(|&o| o == owners[0]),
+        "one rank owns all {n}"
+    );
+    let history = ContactHistory::default();
+    let ends = same_motion_from_history(&world, &history, params, dt, 1000, &[lopsided], Some(1.2));
+    for end in &ends[0] {
+        assert_eq!(end.rebalances, 1, "one bisection brings it under 1.2");
+        assert!(
+            end.imbalance < 1.2,
+            "imbalance {} at the last renewal",
+            end.imbalance
+        );
+        let owned = end.world.particles.owned();
+        assert!(owned > n / 5, "{owned} owned");
+    }
 }
