@@ -5,18 +5,21 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 # The Rust toolchain is the machine's own; rustfmt and clippy come with it. Feature
-# sets built: default (no zenoh) and `zenoh` (the transport; its protoc is vendored).
-# The workspace's second member, python/, is the Python module (PyO3).
+# sets built: default (no zenoh, no MPI) and `zenoh,mpi` (the transport, its protoc
+# vendored; MPI ranks over Debian's OpenMPI). The workspace's second member,
+# python/, is the Python module (PyO3).
+echo "== system packages (OpenMPI, libclang)"
+scripts/system-deps.sh
 echo "== format"
 cargo fmt --all --check
-echo "== clippy (default features, then --features zenoh, then the Python module)"
+echo "== clippy (default features, then --features zenoh,mpi, then the Python module)"
 cargo clippy --all-targets --locked -- -D warnings
-cargo clippy --all-targets --locked --features zenoh -- -D warnings
+cargo clippy --all-targets --locked --features zenoh,mpi -- -D warnings
 cargo clippy -p talus-python --all-targets --locked -- -D warnings
 echo "== build (the talus program and libtalus.so, used by the C, FMU and zenoh tests)"
-cargo build --locked --features zenoh
-echo "== tests (--features zenoh: everything)"
-cargo test --locked --all-targets --features zenoh
+cargo build --locked --features zenoh,mpi
+echo "== tests (--features zenoh,mpi: everything; the MPI tests start mpirun themselves)"
+cargo test --locked --all-targets --features zenoh,mpi
 echo "== benchmarks build"
 cargo bench --locked --no-run
 echo "== Python environment (fmpy, zenoh client, maturin)"

@@ -13,42 +13,7 @@ use talus::world::{Particles, World};
 
 /// Four layers of dodecahedra, randomly turned and close enough to overlap, on the
 /// floor of a box.
-const BOX: &str = r#"
-[simulation]
-dt = 1e-5
-end_time = 1.0
-gravity = [0.0, 0.0, -9.81]
-seed = 5
-
-[contact]
-regularisation = 0.2
-
-[materials.pla]
-density = 1500.0
-young = 1e6
-poisson = 0.1
-restitution = 0.3
-friction = 0.5
-
-[shapes.dodecahedron]
-kind = "platonic"
-solid = "dodecahedron"
-circumradius = 0.005
-
-[[wall]]
-name = "box"
-material = "pla"
-geometry = { kind = "box", min = [-0.001, -0.001, 0.0], max = [0.048, 0.048, 0.1], open_top = true }
-
-[[particles]]
-kind = "lattice"
-shape = "dodecahedron"
-material = "pla"
-min = [0.0, 0.0, -0.0004]
-max = [0.0472, 0.0472, 0.038]
-spacing = 0.00925
-velocity = [0.0, 0.0, -0.1]
-"#;
+const BOX: &str = include_str!("scenes/lattice_box.toml");
 
 fn world_of(text: &str) -> World {
     Scene::parse(text, Path::new("box.toml"))

@@ -4,8 +4,9 @@
 //! is how the decomposition is tested without MPI and how one machine can run
 //! ranks without it.
 
-use std::any::Any;
 use std::sync::{Arc, Barrier, Mutex};
+
+use super::wire::{Message, decode_list, encode_list};
 
 /// Collective operations among the ranks of a run. Every rank calls each operation
 /// in the same order (they block until all have).
@@ -16,28 +17,41 @@ pub trait Exchange {
     /// Number of ranks.
     fn size(&self) -> usize;
 
-    /// Sends `outgoing[r]` to rank `r` (`outgoing` has one list per rank; this
-    /// rank's own is handed back too) and returns what every rank sent this one, in
-    /// rank order.
-    fn all_to_all<T: Clone + Send + 'static>(&self, outgoing: Vec<Vec<T>>) -> Vec<Vec<T>>;
+    /// Sends `outgoing[r]` to rank `r` (one list of words per rank; this rank's own
+    /// is handed back too) and returns what every rank sent this one, in rank order.
+    fn all_to_all_words(&self, outgoing: Vec<Vec<u64>>) -> Vec<Vec<u64>>;
+
+    /// [`Exchange::all_to_all_words`] of messages.
+    fn all_to_all<T: Message>(&self, outgoing: Vec<Vec<T>>) -> Vec<Vec<T>>
+    where
+        Self: Sized,
+    {
+        let words = outgoing.iter().map(|list| encode_list(list)).collect();
+        self.all_to_all_words(words)
+            .iter()
+            .map(|w| decode_list(w))
+            .collect()
+    }
 
     /// Whether any rank passes `true`.
-    fn any(&self, mine: bool) -> bool {
+    fn any(&self, mine: bool) -> bool
+    where
+        Self: Sized,
+    {
         let answers = self.all_to_all(vec![vec![mine]; self.size()]);
         answers.iter().flatten().any(|&b| b)
     }
 }
 
-/// A message slot per (sender, receiver) pair.
-type Slots = Vec<Vec<Option<Box<dyn Any + Send>>>>;
-
 /// The ranks of a run as threads of one process: [`ThreadExchange::group`] makes one
-/// per rank, each moved to its own thread.
+/// per rank, each moved to its own thread. Messages go through the same words as
+/// under MPI.
 #[derive(Clone)]
 pub struct ThreadExchange {
     rank: usize,
     size: usize,
-    slots: Arc<Mutex<Slots>>,
+    /// A slot per (sender, receiver).
+    slots: Arc<Mutex<Vec<Vec<Vec<u64>>>>>,
     barrier: Arc<Barrier>,
 }
 
@@ -54,11 +68,7 @@ impl std::fmt::Debug for ThreadExchange {
 impl ThreadExchange {
     /// One exchange for each of `size` ranks.
     pub fn group(size: usize) -> Vec<ThreadExchange> {
-        let slots = Arc::new(Mutex::new(
-            (0..size)
-                .map(|_| (0..size).map(|_| None).collect())
-                .collect(),
-        ));
+        let slots = Arc::new(Mutex::new(vec![vec![Vec::new(); size]; size]));
         let barrier = Arc::new(Barrier::new(size));
         (0..size)
             .map(|rank| ThreadExchange {
@@ -80,24 +90,14 @@ impl Exchange for ThreadExchange {
         self.size
     }
 
-    fn all_to_all<T: Clone + Send + 'static>(&self, outgoing: Vec<Vec<T>>) -> Vec<Vec<T>> {
+    fn all_to_all_words(&self, outgoing: Vec<Vec<u64>>) -> Vec<Vec<u64>> {
         assert_eq!(outgoing.len(), self.size, "one list per rank");
-        {
-            let mut slots = self.slots.lock().expect("no rank panicked");
-            for (to, list) in outgoing.into_iter().enumerate() {
-                slots[self.rank][to] = Some(Box::new(list));
-            }
-        }
+        self.slots.lock().expect("no rank panicked")[self.rank] = outgoing;
         self.barrier.wait();
         let received = {
             let mut slots = self.slots.lock().expect("no rank panicked");
             (0..self.size)
-                .map(|from| {
-                    let message = slots[from][self.rank].take().expect("every rank sent");
-                    *message
-                        .downcast::<Vec<T>>()
-                        .expect("every rank sends the same type")
-                })
+                .map(|from| std::mem::take(&mut slots[from][self.rank]))
                 .collect()
         };
         // Nobody writes the next round's slots before everyone took this round's.

@@ -23,11 +23,14 @@ pub mod exchange;
 mod fast_hash;
 pub mod integrate;
 mod laws;
+#[cfg(feature = "mpi")]
+pub mod mpi_exchange;
 pub mod neighbours;
 pub mod params;
 pub mod rank;
 pub mod stats;
 pub mod time_step;
+pub mod wire;
 
 pub use backend::{Backend, ContactHistory, WallKey};
 pub use cpu::CpuBackend;

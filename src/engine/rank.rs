@@ -29,6 +29,7 @@ use super::decomposition::Decomposition;
 use super::exchange::Exchange;
 use super::neighbours::{NeighbourList, automatic_skin};
 use super::params::StepParams;
+use super::wire::{Message, Words};
 use crate::Real;
 use crate::world::{Particles, World};
 
@@ -70,6 +71,41 @@ impl ParticleRecord {
         p.orientation[i] = self.orientation;
         p.velocity[i] = self.velocity;
         p.angular_momentum[i] = self.angular_momentum;
+    }
+}
+
+impl Message for ParticleRecord {
+    fn encode(&self, out: &mut Vec<u64>) {
+        out.extend([self.id, u64::from(self.body_type), u64::from(self.frozen)]);
+        self.position.encode(out);
+        self.orientation.encode(out);
+        self.velocity.encode(out);
+        self.angular_momentum.encode(out);
+    }
+    fn decode(words: &mut Words<'_>) -> Self {
+        ParticleRecord {
+            id: words.next_word(),
+            body_type: words.next_word() as u32,
+            frozen: words.next_word() != 0,
+            position: Point3::decode(words),
+            orientation: UnitQuaternion::decode(words),
+            velocity: Vector3::decode(words),
+            angular_momentum: Vector3::decode(words),
+        }
+    }
+}
+
+impl Message for Migrant {
+    fn encode(&self, out: &mut Vec<u64>) {
+        self.particle.encode(out);
+        self.history.encode(out);
+    }
+    fn decode(words: &mut Words<'_>) -> Self {
+        let particle = ParticleRecord::decode(words);
+        Migrant {
+            particle,
+            history: ContactHistory::decode(words),
+        }
     }
 }
 
@@ -190,6 +226,11 @@ impl<E: Exchange> RankStepper<E> {
         &self.decomposition
     }
 
+    /// How this rank talks to the others.
+    pub fn exchange(&self) -> &E {
+        &self.exchange
+    }
+
     /// The backend (figures and lists of this rank's share).
     pub fn backend(&self) -> &CpuBackend {
         &self.backend
@@ -224,17 +265,23 @@ impl<E: Exchange> RankStepper<E> {
 
     /// Copies the owned particles' states to the ranks where they are ghosts.
     fn refresh_ghosts(&mut self, world: &mut World) {
+        let received = self.send_ghost_states(world);
+        let p = &mut world.particles;
+        for (k, record) in received.iter().flatten().enumerate() {
+            record.set_motion(p, p.owned() + k);
+        }
+    }
+
+    /// Sends the states of the owned particles in `sends` to their ranks; returns
+    /// what the other ranks sent this one, in rank order.
+    fn send_ghost_states(&self, world: &World) -> Vec<Vec<ParticleRecord>> {
         let p = &world.particles;
         let outgoing = self
             .sends
             .iter()
             .map(|list| list.iter().map(|&i| ParticleRecord::of(p, i)).collect())
             .collect();
-        let received: Vec<Vec<ParticleRecord>> = self.exchange.all_to_all(outgoing);
-        let p = &mut world.particles;
-        for (k, record) in received.iter().flatten().enumerate() {
-            record.set_motion(p, p.owned() + k);
-        }
+        self.exchange.all_to_all(outgoing)
     }
 
     /// Moves the particles that left the box to their owners, with their history,
@@ -334,12 +381,7 @@ impl<E: Exchange> RankStepper<E> {
                 self.sends[r].push(i);
             }
         }
-        let outgoing = self
-            .sends
-            .iter()
-            .map(|list| list.iter().map(|&i| ParticleRecord::of(p, i)).collect())
-            .collect();
-        let received: Vec<Vec<ParticleRecord>> = self.exchange.all_to_all(outgoing);
+        let received = self.send_ghost_states(world);
         let p = &mut world.particles;
         for r in received.iter().flatten() {
             p.push_ghost(r.body_type, r.position, r.orientation, r.id);
