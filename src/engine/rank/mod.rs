@@ -21,100 +21,23 @@
 
 use std::collections::BTreeMap;
 
-use nalgebra::{Point3, UnitQuaternion, Vector3};
+use nalgebra::Point3;
 
 use super::backend::{Backend, ContactHistory};
 use super::cpu::CpuBackend;
 use super::decomposition::Decomposition;
 use super::exchange::Exchange;
-use super::neighbours::{NeighbourList, automatic_skin};
+use super::neighbours::automatic_skin;
 use super::params::StepParams;
-use super::wire::{Message, Words};
 use crate::Real;
-use crate::world::{Particles, World};
+use crate::world::World;
 
-/// A particle's state as it travels between ranks.
-#[derive(Clone, Debug, PartialEq)]
-pub struct ParticleRecord {
-    /// Stable id.
-    pub id: u64,
-    /// Body type index.
-    pub body_type: u32,
-    /// Frozen (part of a bed at rest).
-    pub frozen: bool,
-    /// Centroid.
-    pub position: Point3<Real>,
-    /// Orientation.
-    pub orientation: UnitQuaternion<Real>,
-    /// Linear velocity.
-    pub velocity: Vector3<Real>,
-    /// Angular momentum (world frame).
-    pub angular_momentum: Vector3<Real>,
-}
+mod cost;
+mod records;
 
-impl ParticleRecord {
-    fn of(p: &Particles, i: usize) -> Self {
-        ParticleRecord {
-            id: p.id[i],
-            body_type: p.body_type[i],
-            frozen: p.frozen[i],
-            position: p.position[i],
-            orientation: p.orientation[i],
-            velocity: p.velocity[i],
-            angular_momentum: p.angular_momentum[i],
-        }
-    }
-
-    /// Writes the motion state into entry `i`.
-    fn set_motion(&self, p: &mut Particles, i: usize) {
-        p.position[i] = self.position;
-        p.orientation[i] = self.orientation;
-        p.velocity[i] = self.velocity;
-        p.angular_momentum[i] = self.angular_momentum;
-    }
-}
-
-impl Message for ParticleRecord {
-    fn encode(&self, out: &mut Vec<u64>) {
-        out.extend([self.id, u64::from(self.body_type), u64::from(self.frozen)]);
-        self.position.encode(out);
-        self.orientation.encode(out);
-        self.velocity.encode(out);
-        self.angular_momentum.encode(out);
-    }
-    fn decode(words: &mut Words<'_>) -> Self {
-        ParticleRecord {
-            id: words.next_word(),
-            body_type: words.next_word() as u32,
-            frozen: words.next_word() != 0,
-            position: Point3::decode(words),
-            orientation: UnitQuaternion::decode(words),
-            velocity: Vector3::decode(words),
-            angular_momentum: Vector3::decode(words),
-        }
-    }
-}
-
-impl Message for Migrant {
-    fn encode(&self, out: &mut Vec<u64>) {
-        self.particle.encode(out);
-        self.history.encode(out);
-    }
-    fn decode(words: &mut Words<'_>) -> Self {
-        let particle = ParticleRecord::decode(words);
-        Migrant {
-            particle,
-            history: ContactHistory::decode(words),
-        }
-    }
-}
-
-/// A particle changing owner, with the history of its pairs and wall patches.
-#[derive(Clone, Debug)]
-struct Migrant {
-    particle: ParticleRecord,
-    history: ContactHistory,
-}
+pub use cost::{PARTICLE_COST, POLYHEDRON_PAIR_COST, particle_costs};
+pub use records::ParticleRecord;
+use records::{Migrant, history_of};
 
 /// Steps one rank's share of a decomposed world.
 ///
@@ -389,62 +312,4 @@ impl<E: Exchange> RankStepper<E> {
             r.set_motion(p, i);
         }
     }
-}
-
-/// The entries of `history` that concern particle `id`.
-fn history_of(history: &ContactHistory, id: u64) -> ContactHistory {
-    ContactHistory {
-        pairs: history
-            .pairs
-            .iter()
-            .filter(|((a, b), _)| *a == id || *b == id)
-            .copied()
-            .collect(),
-        walls: history
-            .walls
-            .iter()
-            .filter(|(key, _)| key.0 == id)
-            .copied()
-            .collect(),
-    }
-}
-
-/// Cost of a candidate pair with a polyhedron against one of two spheres: a
-/// dodecahedron bed steps about 670 ns a contact on one thread (1.5e6 contacts/s),
-/// a settled sphere bed about 170 ns (2.2 ms a step for 12 800 contacts; README,
-/// "Known limits").
-pub const POLYHEDRON_PAIR_COST: Real = 4.0;
-
-/// A particle's own cost (integration, its walls) in sphere pairs: integration
-/// takes 0.15 of the sphere bed's 2.2 ms for 5000 particles, walls 0.35 ms.
-pub const PARTICLE_COST: Real = 0.3;
-
-/// Each owned particle's share of a step's cost, in sphere pairs: its own cost and
-/// half of each of its candidate pairs (a pair of two spheres 1, else
-/// [`POLYHEDRON_PAIR_COST`]).
-pub fn particle_costs(world: &World, list: &NeighbourList) -> Vec<Real> {
-    let p = &world.particles;
-    let is_sphere = |i: usize| {
-        world.body_types[p.body_type[i] as usize]
-            .shape
-            .as_polyhedron()
-            .is_none()
-    };
-    (0..p.owned())
-        .map(|i| {
-            let pairs: Real = list
-                .incident(i)
-                .iter()
-                .map(|e| {
-                    let [a, b] = list.pairs()[e.pair()];
-                    if is_sphere(a as usize) && is_sphere(b as usize) {
-                        0.5
-                    } else {
-                        0.5 * POLYHEDRON_PAIR_COST
-                    }
-                })
-                .sum();
-            PARTICLE_COST + pairs
-        })
-        .collect()
 }

@@ -1,0 +1,110 @@
+//! What ranks send each other of a particle: its state (for a ghost or a migrant)
+//! and, when it changes owner, its contact history.
+
+use nalgebra::{Point3, UnitQuaternion, Vector3};
+
+use crate::Real;
+use crate::engine::backend::ContactHistory;
+use crate::engine::wire::{Message, Words};
+use crate::world::Particles;
+
+/// A particle's state as it travels between ranks.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ParticleRecord {
+    /// Stable id.
+    pub id: u64,
+    /// Body type index.
+    pub body_type: u32,
+    /// Frozen (part of a bed at rest).
+    pub frozen: bool,
+    /// Centroid.
+    pub position: Point3<Real>,
+    /// Orientation.
+    pub orientation: UnitQuaternion<Real>,
+    /// Linear velocity.
+    pub velocity: Vector3<Real>,
+    /// Angular momentum (world frame).
+    pub angular_momentum: Vector3<Real>,
+}
+
+impl ParticleRecord {
+    pub(super) fn of(p: &Particles, i: usize) -> Self {
+        ParticleRecord {
+            id: p.id[i],
+            body_type: p.body_type[i],
+            frozen: p.frozen[i],
+            position: p.position[i],
+            orientation: p.orientation[i],
+            velocity: p.velocity[i],
+            angular_momentum: p.angular_momentum[i],
+        }
+    }
+
+    /// Writes the motion state into entry `i`.
+    pub(super) fn set_motion(&self, p: &mut Particles, i: usize) {
+        p.position[i] = self.position;
+        p.orientation[i] = self.orientation;
+        p.velocity[i] = self.velocity;
+        p.angular_momentum[i] = self.angular_momentum;
+    }
+}
+
+impl Message for ParticleRecord {
+    fn encode(&self, out: &mut Vec<u64>) {
+        out.extend([self.id, u64::from(self.body_type), u64::from(self.frozen)]);
+        self.position.encode(out);
+        self.orientation.encode(out);
+        self.velocity.encode(out);
+        self.angular_momentum.encode(out);
+    }
+    fn decode(words: &mut Words<'_>) -> Self {
+        ParticleRecord {
+            id: words.next_word(),
+            body_type: words.next_word() as u32,
+            frozen: words.next_word() != 0,
+            position: Point3::decode(words),
+            orientation: UnitQuaternion::decode(words),
+            velocity: Vector3::decode(words),
+            angular_momentum: Vector3::decode(words),
+        }
+    }
+}
+
+impl Message for Migrant {
+    fn encode(&self, out: &mut Vec<u64>) {
+        self.particle.encode(out);
+        self.history.encode(out);
+    }
+    fn decode(words: &mut Words<'_>) -> Self {
+        let particle = ParticleRecord::decode(words);
+        Migrant {
+            particle,
+            history: ContactHistory::decode(words),
+        }
+    }
+}
+
+/// A particle changing owner, with the history of its pairs and wall patches.
+#[derive(Clone, Debug)]
+pub(super) struct Migrant {
+    pub(super) particle: ParticleRecord,
+    pub(super) history: ContactHistory,
+}
+
+/// The entries of `history` that concern particle `id`.
+pub(super) fn history_of(history: &ContactHistory, id: u64) -> ContactHistory {
+    ContactHistory {
+        pairs: history
+            .pairs
+            .iter()
+            .filter(|((a, b), _)| *a == id || *b == id)
+            .copied()
+            .collect(),
+        walls: history
+            .walls
+            .iter()
+            .filter(|(key, _)| key.0 == id)
+            .copied()
+            .collect(),
+    }
+}
