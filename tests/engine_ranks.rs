@@ -1,8 +1,8 @@
 //! A world split among ranks (threads talking through a `ThreadExchange`) moves
 //! every particle to the same bits as one process: the ranks own the particles in
 //! their boxes, copy those within reach to each other as ghosts, renew their lists
-//! when one process would, and hand particles that cross a box's face over with
-//! their contact history.
+//! when one process would, hand particles that cross a box's face over with their
+//! contact history, and insert from inlets the particles one process inserts.
 
 use std::ops::ControlFlow;
 use std::path::Path;
@@ -89,7 +89,6 @@ fn same_motion_from_history(
     for _ in 0..steps {
         one.step(&mut whole, dt);
     }
-    let q = &whole.particles;
     let mut ends = Vec::new();
     for layout in layouts {
         let ranks = layout.ranks();
@@ -119,50 +118,56 @@ fn same_motion_from_history(
                 .collect();
             handles.into_iter().map(|h| h.join().unwrap()).collect()
         });
-        let mut seen = 0;
-        for end in &results {
-            let (w, renewals) = (&end.world, end.renewals);
-            // The first list is built at the start, the others at renewals.
-            assert_eq!(
-                renewals as u64 + 1,
-                one.neighbours().builds(),
-                "{ranks} ranks"
-            );
-            let p = &w.particles;
-            for i in 0..p.owned() {
-                let j = q.index_of(p.id[i]).unwrap();
-                let id = p.id[i];
-                assert_eq!(p.position[i], q.position[j], "{ranks} ranks: particle {id}");
-                assert_eq!(p.orientation[i], q.orientation[j], "{ranks} ranks: {id}");
-                assert_eq!(p.velocity[i], q.velocity[j], "{ranks} ranks: {id}");
-                assert_eq!(
-                    p.angular_momentum[i], q.angular_momentum[j],
-                    "{ranks} ranks"
-                );
-                assert_eq!(p.frozen[i], q.frozen[j]);
-                seen += 1;
-            }
-        }
-        assert_eq!(seen, q.len(), "{ranks} ranks: every particle owned once");
-        for (k, wall) in whole.walls.iter().enumerate() {
-            let force: Vector3<Real> = results.iter().map(|r| r.world.walls[k].force).sum();
-            let torque: Vector3<Real> = results.iter().map(|r| r.world.walls[k].torque).sum();
-            let close =
-                |a: Vector3<Real>, b: Vector3<Real>| (a - b).norm() <= 1e-12 * b.norm().max(1e-300);
-            assert!(
-                close(force, wall.force),
-                "{ranks} ranks: {force} for {}",
-                wall.force
-            );
-            assert!(
-                close(torque, wall.torque),
-                "{ranks} ranks: {torque} for {}",
-                wall.torque
-            );
-        }
+        assert_same_as_one_process(&whole, one.neighbours().builds(), &results);
         ends.push(results);
     }
     ends
+}
+
+/// Checks the ranks' `results` against the one-process world `whole`, whose lists
+/// were built `builds` times: every particle owned once with the same state to the
+/// bit, the renewals at the one-process list builds, and each wall's force and
+/// torque summed over the ranks within 1e-12 (each rank sums its own particles'
+/// share in its storage order: the round-off of a different order).
+fn assert_same_as_one_process(whole: &World, builds: u64, results: &[RankEnd]) {
+    let (q, ranks) = (&whole.particles, results.len());
+    let mut seen = 0;
+    for end in results {
+        let (w, renewals) = (&end.world, end.renewals);
+        // The first list is built at the start, the others at renewals.
+        assert_eq!(renewals as u64 + 1, builds, "{ranks} ranks");
+        let p = &w.particles;
+        for i in 0..p.owned() {
+            let j = q.index_of(p.id[i]).unwrap();
+            let id = p.id[i];
+            assert_eq!(p.position[i], q.position[j], "{ranks} ranks: particle {id}");
+            assert_eq!(p.orientation[i], q.orientation[j], "{ranks} ranks: {id}");
+            assert_eq!(p.velocity[i], q.velocity[j], "{ranks} ranks: {id}");
+            assert_eq!(
+                p.angular_momentum[i], q.angular_momentum[j],
+                "{ranks} ranks"
+            );
+            assert_eq!(p.frozen[i], q.frozen[j]);
+            seen += 1;
+        }
+    }
+    assert_eq!(seen, q.len(), "{ranks} ranks: every particle owned once");
+    for (k, wall) in whole.walls.iter().enumerate() {
+        let force: Vector3<Real> = results.iter().map(|r| r.world.walls[k].force).sum();
+        let torque: Vector3<Real> = results.iter().map(|r| r.world.walls[k].torque).sum();
+        let close =
+            |a: Vector3<Real>, b: Vector3<Real>| (a - b).norm() <= 1e-12 * b.norm().max(1e-300);
+        assert!(
+            close(force, wall.force),
+            "{ranks} ranks: {force} for {}",
+            wall.force
+        );
+        assert!(
+            close(torque, wall.torque),
+            "{ranks} ranks: {torque} for {}",
+            wall.torque
+        );
+    }
 }
 
 fn migrated(ends: &[RankEnd]) -> usize {
@@ -182,6 +187,94 @@ fn a_shaken_box_of_polyhedra_moves_alike_on_two_three_and_four_ranks() {
             "{} ranks: {moved} particles changed rank",
             layout.ranks()
         );
+    }
+}
+
+/// The settling box poured from its inlet from the start (one particle every
+/// 0.5 ms falling from the upper half of the box), and from 0.04 s a second inlet
+/// of smaller dodecahedra: the ranks place the particles one process places (the
+/// same places, orientations and ids, the same draws), each on the rank that owns
+/// its place, then move every particle as one process does while they fall through
+/// the boxes' planes onto the floor and each other. The smaller particles shrink
+/// the automatic skin at the next list build, on the ranks as in one process.
+#[test]
+fn an_inlet_pours_alike_on_ranks() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/settling_box/scene.toml");
+    let grit = r#"
+[shapes.grit]
+kind = "platonic"
+solid = "dodecahedron"
+circumradius = 0.003
+
+[[inlet]]
+shape = "grit"
+material = "pla"
+min = [0.0, 0.0, 0.06]
+max = [0.06, 0.06, 0.12]
+rate = 1000.0
+count = 40
+velocity = [0.0, 0.0, -0.5]
+start = 0.04
+"#;
+    let text = std::fs::read_to_string(&path).unwrap() + grit;
+    let scene = Scene::parse(&text, &path).unwrap();
+    let steps = (0.12 / scene.dt) as usize;
+    let mut sim = Simulation::new(&scene);
+    for _ in 0..steps {
+        sim.step();
+    }
+    let poured = sim.world().particles.len();
+    assert!(poured > 190, "{poured} particles poured");
+    // Boxes bisected at a lattice filling the box (0.06 × 0.06 × 0.12 m): two ranks
+    // split it at half height, the inlet's lower face.
+    let lattice: Vec<Point3<Real>> = (0..3 * 3 * 6)
+        .map(|k| Point3::new(k % 3, (k / 3) % 3, k / 9).cast::<Real>() * 0.02)
+        .map(|x| x + Vector3::repeat(0.01))
+        .collect();
+    for ranks in [2, 3] {
+        let layout = Decomposition::bisect(&lattice, &vec![1.0; lattice.len()], ranks);
+        let results: Vec<(RankEnd, usize)> = std::thread::scope(|s| {
+            let handles: Vec<_> = ThreadExchange::group(ranks)
+                .into_iter()
+                .map(|exchange| {
+                    let (layout, scene) = (layout.clone(), &scene);
+                    s.spawn(move || {
+                        // What is due at 0 goes in before the first forces, as in one
+                        // process; every rank starts from the same world.
+                        let (mut world, mut inlets) = (scene.world.clone(), scene.inlets.clone());
+                        let mut next_id = scene.next_id;
+                        let mut placed = 0;
+                        for inlet in &mut inlets {
+                            placed += inlet.insert_due(&mut world, 0.0, &mut next_id);
+                        }
+                        let (params, history) = (scene.step_params(), ContactHistory::default());
+                        let mut rank = RankStepper::new(
+                            exchange, layout, params, &mut world, &history, scene.dt,
+                        );
+                        for _ in 0..steps {
+                            rank.step(&mut world, scene.dt);
+                            placed += rank.insert(&mut world, &mut inlets, &mut next_id);
+                        }
+                        let end = RankEnd {
+                            world,
+                            migrated: rank.migrated(),
+                            renewals: rank.renewals(),
+                            rebalances: rank.rebalances(),
+                            imbalance: rank.imbalance(),
+                        };
+                        (end, placed)
+                    })
+                })
+                .collect();
+            handles.into_iter().map(|h| h.join().unwrap()).collect()
+        });
+        for (_, placed) in &results {
+            assert_eq!(*placed, poured, "{ranks} ranks: every rank placed them all");
+        }
+        let ends: Vec<RankEnd> = results.into_iter().map(|(end, _)| end).collect();
+        assert_same_as_one_process(sim.world(), sim.stats().list_builds, &ends);
+        let moved = migrated(&ends);
+        assert!(moved >= 20, "{ranks} ranks: {moved} particles changed rank");
     }
 }
 

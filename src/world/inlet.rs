@@ -10,12 +10,40 @@ use nalgebra::{Point3, Quaternion, UnitQuaternion, Vector3};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 
-use super::World;
+use std::ops::Range;
+
+use super::{Particles, World};
 use crate::Real;
 use crate::geometry::sphere::closest_point_on_triangle;
 
 /// Random positions tried per particle and step.
 pub const PLACEMENT_ATTEMPTS: usize = 64;
+
+/// The bounding sphere of a particle an inlet must place clear of.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Obstacle {
+    pub centre: Point3<Real>,
+    pub radius: Real,
+}
+
+/// A particle an inlet placed, before it is inserted.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PlacedParticle {
+    pub body_type: u32,
+    pub position: Point3<Real>,
+    pub orientation: UnitQuaternion<Real>,
+    pub velocity: Vector3<Real>,
+    pub id: u64,
+}
+
+impl PlacedParticle {
+    /// Appends it to the owned particles, at rest but for its velocity.
+    pub fn push_into(&self, particles: &mut Particles) {
+        particles.push(self.body_type, self.position, self.orientation, self.id);
+        let i = particles.owned() - 1;
+        particles.velocity[i] = self.velocity;
+    }
+}
 
 /// A particle source.
 #[derive(Clone, Debug)]
@@ -96,46 +124,92 @@ impl Inlet {
         self.inserted >= self.count
     }
 
+    /// Whether particles may be due at time `t` (started, not done).
+    pub fn is_due(&self, t: Real) -> bool {
+        !self.is_done() && t >= self.start
+    }
+
     /// Inserts the particles due by time `t` into `world`, giving them ids from
     /// `next_id` on; returns how many were inserted.
     pub fn insert_due(&mut self, world: &mut World, t: Real, next_id: &mut u64) -> usize {
-        if self.is_done() || t < self.start {
+        if !self.is_due(t) {
             return 0;
         }
-        let due = (((t - self.start) * self.rate).floor() as usize + 1).min(self.count);
-        let radius = world.body_types[self.body_type as usize]
-            .shape
-            .circumradius();
-        let mut placed = 0;
-        // Only the particles whose bounding spheres reach into the box can be in the
-        // way: found once per call, not once per attempt (a long bed is far below).
+        let obstacles = self.obstacles(world, 0..world.particles.len());
+        let placed = self.place_due(world, obstacles, t, next_id);
+        for particle in &placed {
+            particle.push_into(&mut world.particles);
+        }
+        placed.len()
+    }
+
+    /// The bounding spheres of `world`'s particles `among` that reach into the range
+    /// of centres the inlet draws from: only they can be in the way (found once per
+    /// call, not once per attempt: a long bed is far below).
+    pub fn obstacles(&self, world: &World, among: Range<usize>) -> Vec<Obstacle> {
+        let radius = self.radius(world);
         let (a, b) = self.centre_range(radius);
         let (lo, hi) = (a.inf(&b), a.sup(&b)); // every centre drawn lies in there
         let p = &world.particles;
-        let types = &world.body_types;
-        let mut near: Vec<usize> = (0..p.len())
-            .filter(|&k| {
-                let reach = radius + types[p.body_type[k] as usize].shape.circumradius();
-                let x = p.position[k].coords;
+        among
+            .map(|k| Obstacle {
+                centre: p.position[k],
+                radius: world.body_types[p.body_type[k] as usize]
+                    .shape
+                    .circumradius(),
+            })
+            .filter(|o| {
+                let reach = radius + o.radius;
+                let x = o.centre.coords;
                 (x - x.sup(&lo).inf(&hi)).norm_squared() < reach * reach
             })
-            .collect();
+            .collect()
+    }
+
+    /// Places the particles due by time `t` clear of the `obstacles` (in any order)
+    /// and of `world`'s walls, with ids from `next_id` on, without inserting them.
+    /// The same inlet state, obstacles and walls place the same particles to the
+    /// bit: how the ranks of a decomposed run insert as one process does.
+    pub fn place_due(
+        &mut self,
+        world: &World,
+        mut obstacles: Vec<Obstacle>,
+        t: Real,
+        next_id: &mut u64,
+    ) -> Vec<PlacedParticle> {
+        if !self.is_due(t) {
+            return Vec::new();
+        }
+        let due = (((t - self.start) * self.rate).floor() as usize + 1).min(self.count);
+        let radius = self.radius(world);
+        let mut placed = Vec::new();
         while self.inserted < due {
-            let Some(position) = self.free_position(world, radius, &near) else {
+            let Some(position) = self.free_position(world, radius, &obstacles) else {
                 break;
             };
             let orientation = random_orientation(&mut self.rng);
-            world
-                .particles
-                .push(self.body_type, position, orientation, *next_id);
-            let last = world.particles.len() - 1;
-            world.particles.velocity[last] = self.velocity;
-            near.push(last);
+            placed.push(PlacedParticle {
+                body_type: self.body_type,
+                position,
+                orientation,
+                velocity: self.velocity,
+                id: *next_id,
+            });
+            obstacles.push(Obstacle {
+                centre: position,
+                radius,
+            });
             *next_id += 1;
             self.inserted += 1;
-            placed += 1;
         }
         placed
+    }
+
+    /// The bounding radius of the inserted particles.
+    fn radius(&self, world: &World) -> Real {
+        world.body_types[self.body_type as usize]
+            .shape
+            .circumradius()
     }
 
     /// The box the centre of a particle of bounding radius `radius` is drawn from.
@@ -147,12 +221,12 @@ impl Inlet {
     }
 
     /// A random centre in the box whose ball of `radius` is free (see [`is_free`]),
-    /// checking the particles `near` the box.
+    /// checking the `obstacles` near the box.
     fn free_position(
         &mut self,
         world: &World,
         radius: Real,
-        near: &[usize],
+        obstacles: &[Obstacle],
     ) -> Option<Point3<Real>> {
         let (lo, hi) = self.centre_range(radius);
         for _ in 0..PLACEMENT_ATTEMPTS {
@@ -163,7 +237,7 @@ impl Inlet {
                     0.5 * (a + b)
                 }
             }));
-            if is_free_of(world, near.iter().copied(), &x, radius) {
+            if is_free_of(world, obstacles.iter().copied(), &x, radius) {
                 return Some(x);
             }
         }
@@ -174,22 +248,26 @@ impl Inlet {
 /// Whether a ball at `x` of radius `r` clears every particle's bounding sphere and
 /// every wall facet.
 pub fn is_free(world: &World, x: &Point3<Real>, r: Real) -> bool {
-    is_free_of(world, 0..world.particles.len(), x, r)
+    let p = &world.particles;
+    let balls = (0..p.len()).map(|k| Obstacle {
+        centre: p.position[k],
+        radius: world.body_types[p.body_type[k] as usize]
+            .shape
+            .circumradius(),
+    });
+    is_free_of(world, balls, x, r)
 }
 
-/// [`is_free`] against the particles `candidates` only (and every wall facet).
+/// [`is_free`] against the `obstacles` only (and every wall facet).
 fn is_free_of(
     world: &World,
-    candidates: impl Iterator<Item = usize>,
+    obstacles: impl Iterator<Item = Obstacle>,
     x: &Point3<Real>,
     r: Real,
 ) -> bool {
-    let p = &world.particles;
-    for k in candidates {
-        let rk = world.body_types[p.body_type[k] as usize]
-            .shape
-            .circumradius();
-        if (p.position[k] - x).norm_squared() < (r + rk) * (r + rk) {
+    for o in obstacles {
+        let reach = r + o.radius;
+        if (o.centre - x).norm_squared() < reach * reach {
             return false;
         }
     }

@@ -12,7 +12,7 @@ use nalgebra::Vector3;
 
 pub use cell_shares::CellShares;
 pub use fluid::{DragModel, FluidField, LocalFluid, MomentumExchange, ParticleFluid};
-pub use inlet::{Inlet, PLACEMENT_ATTEMPTS, is_free, random_orientation};
+pub use inlet::{Inlet, Obstacle, PLACEMENT_ATTEMPTS, PlacedParticle, is_free, random_orientation};
 pub use motion::{DriveInput, MotionKey, WallMotion, WallVelocity, advance_pose};
 pub use particles::Particles;
 pub use walls::{FacetGrid, Wall};

@@ -20,6 +20,7 @@
 //! is not evaluated, so that copy may be stale).
 
 use std::collections::BTreeMap;
+use std::ops::Range;
 
 use nalgebra::Point3;
 
@@ -33,6 +34,7 @@ use crate::Real;
 use crate::world::World;
 
 mod cost;
+mod insertion;
 mod records;
 
 pub use cost::{PARTICLE_COST, POLYHEDRON_PAIR_COST, particle_costs};
@@ -52,6 +54,9 @@ pub struct RankStepper<E: Exchange> {
     backend: CpuBackend,
     /// For each rank, the owned particles copied there as ghosts.
     sends: Vec<Vec<usize>>,
+    /// No skin was set: it follows the smallest particle of the whole run at each
+    /// renewal, as one process's lists choose it at each build.
+    automatic_skin: bool,
     /// Bisect again at a renewal where the cost imbalance exceeds this.
     rebalance_above: Option<Real>,
     imbalance: Real,
@@ -66,8 +71,9 @@ impl<E: Exchange> RankStepper<E> {
     /// (twice the largest bounding radius of a body type plus the skin), and
     /// evaluates the forces for a first step of `dt`. `history` is the whole run's
     /// tangential history (of a restored state; empty for a fresh start): the rank
-    /// keeps what concerns its own particles. An automatic skin is fixed here from
-    /// the whole world's particles, as one process would choose it.
+    /// keeps what concerns its own particles. Without a skin in `params` the ranks
+    /// choose it from the whole run's particles at every renewal, as one process
+    /// chooses it at every list build.
     pub fn new(
         exchange: E,
         decomposition: Decomposition,
@@ -77,15 +83,12 @@ impl<E: Exchange> RankStepper<E> {
         dt: Real,
     ) -> Self {
         assert_eq!(exchange.size(), decomposition.ranks(), "one box per rank");
-        let radius = |k: &u32| world.body_types[*k as usize].shape.circumradius();
-        let radii: Vec<Real> = world.particles.body_type.iter().map(radius).collect();
-        let skin = *params.skin.get_or_insert_with(|| automatic_skin(&radii));
-        let largest = world
-            .body_types
-            .iter()
-            .map(|t| t.shape.circumradius())
-            .fold(0.0, Real::max);
-        let reach = 2.0 * largest + skin;
+        // Every rank holds the whole world here: its own radii are everyone's.
+        let automatic = params.skin.is_none();
+        let skin = *params.skin.get_or_insert_with(|| {
+            automatic_skin(&bounding_radii(world, 0..world.particles.len()))
+        });
+        let reach = reach_of(world, skin);
         let me = exchange.rank();
         world.particles.clear_ghosts();
         let positions = world.particles.position.clone();
@@ -94,6 +97,7 @@ impl<E: Exchange> RankStepper<E> {
             .remove_where(|i| decomposition.owner(&positions[i]) != me);
         let mut rank = RankStepper {
             sends: vec![Vec::new(); exchange.size()],
+            automatic_skin: automatic,
             exchange,
             decomposition,
             reach,
@@ -211,6 +215,9 @@ impl<E: Exchange> RankStepper<E> {
     /// and chooses the ghosts again.
     fn renew(&mut self, world: &mut World) {
         self.renewals += 1;
+        if self.automatic_skin {
+            self.follow_smallest_particle(world);
+        }
         if let Some(threshold) = self.rebalance_above {
             self.rebalance(world, threshold);
         }
@@ -260,6 +267,26 @@ impl<E: Exchange> RankStepper<E> {
         };
         // The history is matched to the pairs when the lists are built again.
         self.backend.restore(world, history, stats);
+    }
+
+    /// Sets the skin one process would choose for the whole run's particles now
+    /// (from the smallest bounding radius of every rank's owned particles), and the
+    /// reach with it.
+    fn follow_smallest_particle(&mut self, world: &World) {
+        let size = self.exchange.size();
+        let radii = bounding_radii(world, 0..world.particles.owned());
+        let mine = radii.into_iter().fold(Real::INFINITY, Real::min);
+        let smallest = self
+            .exchange
+            .all_to_all(vec![vec![mine]; size])
+            .concat()
+            .into_iter()
+            .fold(Real::INFINITY, Real::min);
+        let skin = automatic_skin(&[smallest]);
+        let mut params = *self.backend.params();
+        params.skin = Some(skin);
+        self.backend.set_params(params);
+        self.reach = reach_of(world, skin);
     }
 
     /// Measures the imbalance (every rank's total cost to every rank) and, above
@@ -312,4 +339,27 @@ impl<E: Exchange> RankStepper<E> {
             r.set_motion(p, i);
         }
     }
+}
+
+/// The bounding radii of the particles `among`.
+fn bounding_radii(world: &World, among: Range<usize>) -> Vec<Real> {
+    let p = &world.particles;
+    among
+        .map(|i| {
+            world.body_types[p.body_type[i] as usize]
+                .shape
+                .circumradius()
+        })
+        .collect()
+}
+
+/// How far from its box a particle is copied as a ghost: two of the largest
+/// bounding radii of any body type and the skin.
+fn reach_of(world: &World, skin: Real) -> Real {
+    let largest = world
+        .body_types
+        .iter()
+        .map(|t| t.shape.circumradius())
+        .fold(0.0, Real::max);
+    2.0 * largest + skin
 }
