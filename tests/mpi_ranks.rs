@@ -1,5 +1,7 @@
 //! The MPI exchange (feature `mpi`): the ranks of an MPI run move every particle of a
-//! shaken box as one process does, to the bit, with particles changing rank.
+//! shaken box as one process does, to the bit, with particles changing rank; and
+//! `talus bench --ranks` under `mpirun -np 2` reports every particle once, with
+//! ghosts and bytes exchanged.
 //!
 //! This test has no libtest harness (`harness = false` in Cargo.toml): it is its own
 //! MPI program. Started by `cargo test`, it launches itself under `mpirun
@@ -39,7 +41,7 @@ fn main() -> ExitCode {
     if !filters.is_empty() && !filters.iter().any(|f| name.contains(f.as_str())) {
         return ExitCode::SUCCESS;
     }
-    match launch_ranks() {
+    match launch_ranks().and_then(|()| bench_on_two_ranks()) {
         Ok(()) => {
             println!("test {name} ... ok");
             ExitCode::SUCCESS
@@ -88,6 +90,41 @@ fn launch_ranks() -> Result<(), String> {
         if ranks > 1 && changed < 5 {
             return Err(format!("too few particles changed rank: {line}"));
         }
+    }
+    Ok(())
+}
+
+/// `talus bench --ranks` under `mpirun -np 2` on 200 particles of the settled bed:
+/// rank 0's row counts every particle once, with ghosts and words exchanged.
+fn bench_on_two_ranks() -> Result<(), String> {
+    let out = Command::new("mpirun")
+        .args(["--oversubscribe", "-np", "2", env!("CARGO_BIN_EXE_talus")])
+        .args(["bench", "--ranks", "--scale", "0.02", "--steps", "10"])
+        .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
+        .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
+        .output()
+        .map_err(|e| format!("mpirun: {e}"))?;
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let row = stdout
+        .lines()
+        .find(|l| l.starts_with("(a) settled bed"))
+        .ok_or_else(|| {
+            format!(
+                "talus bench --ranks: no row in\n{stdout}\n{}",
+                String::from_utf8_lossy(&out.stderr)
+            )
+        })?;
+    println!("{row}");
+    let cells: Vec<&str> = row["(a) settled bed of dodecahedra".len()..]
+        .split_whitespace()
+        .collect();
+    let number = |k: usize| cells.get(k).and_then(|c| c.parse::<f64>().ok());
+    let (ranks, particles, ghosts, bytes) = (number(0), number(2), number(3), number(7));
+    if ranks != Some(2.0) || particles != Some(200.0) {
+        return Err(format!("2 ranks holding 200 particles expected: {row}"));
+    }
+    if !ghosts.is_some_and(|g| g > 0.0) || !bytes.is_some_and(|b| b > 0.0) {
+        return Err(format!("ghosts and bytes exchanged expected: {row}"));
     }
     Ok(())
 }

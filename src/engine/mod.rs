@@ -7,8 +7,8 @@
 //! ([`integrate`]), the broad phase ([`broad_phase`]), the Verlet lists built from it
 //! ([`neighbours`]), the contact parameters of every pair of body types (`laws`) and
 //! the suggested time step ([`time_step`]); for a run split among ranks, the split
-//! of space ([`decomposition`]), how ranks talk ([`exchange`]) and one rank's step
-//! ([`rank`]). Every stage is written the way a GPU
+//! of space ([`decomposition`]), how ranks talk ([`exchange`]; measured by
+//! [`metered_exchange`]) and one rank's step ([`rank`]). Every stage is written the way a GPU
 //! kernel is: a data-parallel loop over particles or candidate pairs reading flat
 //! arrays and writing its own slot; each particle then gathers its pairs' forces in
 //! pair order, so results do not depend on the number of threads.
@@ -23,6 +23,7 @@ pub mod exchange;
 mod fast_hash;
 pub mod integrate;
 mod laws;
+pub mod metered_exchange;
 #[cfg(feature = "mpi")]
 pub mod mpi_exchange;
 pub mod neighbours;

@@ -58,7 +58,8 @@ const SETTLED_BED: &str = include_str!("../../../benches/data/settled_dodecahedr
 const BED_BOX: [f64; 3] = [0.3155, 0.3155, 0.2];
 
 /// The dodecahedron of scene (a).
-const DODECAHEDRON: &str = "kind = \"platonic\"\nsolid = \"dodecahedron\"\ncircumradius = 0.005";
+pub const DODECAHEDRON: &str =
+    "kind = \"platonic\"\nsolid = \"dodecahedron\"\ncircumradius = 0.005";
 
 /// Scene (a)'s box under gravity with `material` (a `[materials.pla]` table),
 /// `particles` (a `[[particles]]` table) and `extra` lines in `[simulation]`.
@@ -97,7 +98,7 @@ fn pose_file(file: &str) -> String {
 
 /// Scene (a) with the `count` lowest particles of the settled bed, whose poses are
 /// written to `dir`.
-fn settled_bed(dir: &Path, count: usize) -> Result<String> {
+pub fn settled_bed(dir: &Path, count: usize) -> Result<String> {
     let mut rows: Vec<(f64, &str)> = SETTLED_BED
         .lines()
         .filter(|l| !l.trim().is_empty() && !l.starts_with('#'))
@@ -356,7 +357,7 @@ file = "pour.csv"
 }
 
 /// Realised restitution error of a drop of `shape` (a [shapes] entry) at step `dt`.
-fn restitution_error(shape: &str, dt: f64, regularisation: f64) -> f64 {
+pub fn restitution_error(shape: &str, dt: f64, regularisation: f64) -> f64 {
     let text = format!(
         r#"
 [simulation]

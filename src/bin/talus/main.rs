@@ -3,6 +3,8 @@
 mod accuracy;
 mod analyze;
 mod bench;
+#[cfg(feature = "mpi")]
+mod bench_ranks;
 mod bench_shapes;
 mod checkpoint;
 mod contact;
@@ -150,9 +152,13 @@ enum Command {
         /// Measure only these scenes (a, b, c, d; all by default).
         #[arg(long, value_delimiter = ',')]
         scene: Vec<char>,
-        /// Measure on these thread counts.
+        /// Measure on these thread counts (with --ranks: the first, per rank).
         #[arg(long, value_delimiter = ',', default_values_t = [1, 2])]
         threads: Vec<usize>,
+        /// Under `mpirun -np N` (feature `mpi`): step scene (a) on the N ranks and
+        /// print throughput, ghosts, bytes exchanged and time in the exchange.
+        #[arg(long)]
+        ranks: bool,
         /// Instead of measuring, pour the settled bed of scene (a) and write its
         /// poses to this file (about 20 minutes on two cores).
         #[arg(long, value_name = "FILE")]
@@ -169,6 +175,18 @@ enum Command {
         #[arg(long, default_value_t = 1.0)]
         scale: f64,
     },
+}
+
+#[cfg(feature = "mpi")]
+fn bench_on_ranks(options: &bench::BenchOptions) -> Result<()> {
+    bench_ranks::ranks(options)
+}
+
+#[cfg(not(feature = "mpi"))]
+fn bench_on_ranks(_: &bench::BenchOptions) -> Result<()> {
+    anyhow::bail!(
+        "--ranks: this talus was built without the `mpi` feature (cargo build --features mpi)"
+    )
 }
 
 fn main() -> Result<()> {
@@ -243,13 +261,21 @@ fn main() -> Result<()> {
             steps,
             scene,
             threads,
+            ranks,
             ..
-        } => bench::bench(bench::BenchOptions {
-            scale,
-            steps,
-            scenes: scene,
-            threads,
-        }),
+        } => {
+            let options = bench::BenchOptions {
+                scale,
+                steps,
+                scenes: scene,
+                threads,
+            };
+            if ranks {
+                bench_on_ranks(&options)
+            } else {
+                bench::bench(options)
+            }
+        }
         Command::Inspect { mesh, hull, scale } => {
             let spec = ShapeSpec::Mesh {
                 file: mesh.clone(),
