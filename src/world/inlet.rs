@@ -26,6 +26,19 @@ pub struct Obstacle {
     pub radius: Real,
 }
 
+impl Obstacle {
+    /// The bounding sphere of `world`'s particle `k`.
+    pub fn of(world: &World, k: usize) -> Self {
+        let p = &world.particles;
+        Obstacle {
+            centre: p.position[k],
+            radius: world.body_types[p.body_type[k] as usize]
+                .shape
+                .circumradius(),
+        }
+    }
+}
+
 /// A particle an inlet placed, before it is inserted.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PlacedParticle {
@@ -150,14 +163,8 @@ impl Inlet {
         let radius = self.radius(world);
         let (a, b) = self.centre_range(radius);
         let (lo, hi) = (a.inf(&b), a.sup(&b)); // every centre drawn lies in there
-        let p = &world.particles;
         among
-            .map(|k| Obstacle {
-                centre: p.position[k],
-                radius: world.body_types[p.body_type[k] as usize]
-                    .shape
-                    .circumradius(),
-            })
+            .map(|k| Obstacle::of(world, k))
             .filter(|o| {
                 let reach = radius + o.radius;
                 let x = o.centre.coords;
@@ -248,13 +255,7 @@ impl Inlet {
 /// Whether a ball at `x` of radius `r` clears every particle's bounding sphere and
 /// every wall facet.
 pub fn is_free(world: &World, x: &Point3<Real>, r: Real) -> bool {
-    let p = &world.particles;
-    let balls = (0..p.len()).map(|k| Obstacle {
-        centre: p.position[k],
-        radius: world.body_types[p.body_type[k] as usize]
-            .shape
-            .circumradius(),
-    });
+    let balls = (0..world.particles.len()).map(|k| Obstacle::of(world, k));
     is_free_of(world, balls, x, r)
 }
 
