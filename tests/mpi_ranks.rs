@@ -17,7 +17,7 @@ use rand::{Rng, SeedableRng};
 use talus::Real;
 use talus::engine::decomposition::Decomposition;
 use talus::engine::exchange::Exchange;
-use talus::engine::mpi_exchange::MpiExchange;
+use talus::engine::mpi_exchange;
 use talus::engine::rank::RankStepper;
 use talus::engine::{Backend, ContactHistory, CpuBackend};
 use talus::scene::Scene;
@@ -135,8 +135,7 @@ fn bench_on_two_ranks() -> Result<(), String> {
 /// particle is owned once and that the wall force summed over them is the
 /// reference's within 1e-12. Panics (a non-zero exit) on any difference.
 fn run_rank() {
-    let universe = mpi::initialize().expect("MPI initialises once");
-    let exchange = MpiExchange::new(universe.world());
+    let (_universe, exchange) = mpi_exchange::start().expect("MPI starts once");
     let (rank, size) = (exchange.rank(), exchange.size());
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/scenes/lattice_box.toml");
     let text = std::fs::read_to_string(&path).expect("the scene is shipped");

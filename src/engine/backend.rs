@@ -40,6 +40,7 @@ use std::fmt;
 use std::ops::Range;
 
 use super::params::StepParams;
+use super::rank::Share;
 use super::stats::{StageTimes, StepStats};
 use crate::Real;
 use crate::contact::TangentialHistory;
@@ -125,4 +126,11 @@ pub trait Backend: Send + fmt::Debug {
 
     /// Brings the host world's particle arrays up to date.
     fn sync_to_host(&mut self, world: &mut World);
+
+    /// Where the host's world is one rank's share of a decomposed run: the other
+    /// ranks, through which the host reduces its whole-run figures, gathers the
+    /// whole world and inserts particles. `None` for a backend of the whole world.
+    fn share(&self) -> Option<&dyn Share> {
+        None
+    }
 }

@@ -4,16 +4,24 @@
 
 use mpi::Count;
 use mpi::datatype::{Partition, PartitionMut};
+use mpi::environment::{Threading, Universe};
 use mpi::topology::SimpleCommunicator;
 use mpi::traits::{Communicator, CommunicatorCollectives};
 
 use super::exchange::Exchange;
 
 /// The ranks of a communicator (usually `universe.world()`; the MPI universe must
-/// outlive it).
+/// outlive it). It may move to another thread: MPI was initialised with
+/// [`Threading::Serialized`] or above ([`start`]), and an exchange is not `Sync`,
+/// so its calls never overlap.
 pub struct MpiExchange {
     comm: SimpleCommunicator,
 }
+
+// SAFETY: the communicator is a handle that any thread may use under
+// `MPI_THREAD_SERIALIZED`, which `MpiExchange::new` checks; without `Sync`, only
+// the thread that holds the exchange calls MPI through it.
+unsafe impl Send for MpiExchange {}
 
 impl std::fmt::Debug for MpiExchange {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
@@ -26,10 +34,35 @@ impl std::fmt::Debug for MpiExchange {
     }
 }
 
+/// Why MPI could not be started for a decomposed run.
+#[derive(Debug, thiserror::Error)]
+pub enum MpiStartError {
+    #[error("MPI was initialised already in this process")]
+    AlreadyStarted,
+    #[error(
+        "the MPI library grants calls from one thread only ({0:?}); a decomposed run \
+         needs MPI_THREAD_SERIALIZED"
+    )]
+    Threading(Threading),
+}
+
+/// Initialises MPI with [`Threading::Serialized`]; returns the universe (MPI is
+/// finalised when it is dropped) and the exchange over all its processes.
+pub fn start() -> Result<(Universe, MpiExchange), MpiStartError> {
+    let (universe, _) = mpi::initialize_with_threading(Threading::Serialized)
+        .ok_or(MpiStartError::AlreadyStarted)?;
+    let exchange = MpiExchange::new(universe.world())?;
+    Ok((universe, exchange))
+}
+
 impl MpiExchange {
-    /// The ranks of `comm`.
-    pub fn new(comm: SimpleCommunicator) -> Self {
-        MpiExchange { comm }
+    /// The ranks of `comm`; MPI must grant [`Threading::Serialized`] or above.
+    pub fn new(comm: SimpleCommunicator) -> Result<Self, MpiStartError> {
+        let level = mpi::environment::threading_support();
+        if level < Threading::Serialized {
+            return Err(MpiStartError::Threading(level));
+        }
+        Ok(MpiExchange { comm })
     }
 }
 

@@ -106,6 +106,11 @@ impl NeighbourList {
         &self.pairs
     }
 
+    /// Particles of the world the lists were built for.
+    pub fn particle_count(&self) -> usize {
+        self.incident_starts.len().saturating_sub(1)
+    }
+
     /// The pairs holding particle `k`, ascending.
     pub fn incident(&self, k: usize) -> &[Incidence] {
         &self.incident[self.incident_starts[k] as usize..self.incident_starts[k + 1] as usize]

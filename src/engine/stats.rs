@@ -8,7 +8,10 @@ use crate::Real;
 /// Figures of the last step's force evaluation.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct StepStats {
-    /// Contacts: particle pairs that touch plus particle–wall patches.
+    /// Contacts: particle pairs that touch plus particle–wall patches. On a rank of
+    /// a decomposed run, the counts and energies of pairs are this rank's share: a
+    /// pair of an owned particle and a ghost counts on the rank that owns the one
+    /// of smaller id, so the shares of all ranks add up to one process's.
     pub contacts: usize,
     /// Of them, between particles.
     pub pair_contacts: usize,

@@ -20,6 +20,7 @@
 //!   resumed run takes up the files above where a checkpoint left them
 //!   ([`OutputCursor`]).
 
+mod clock;
 pub mod drum;
 pub mod packing;
 pub mod plot;
@@ -37,6 +38,7 @@ use crate::Real;
 use crate::analysis::{Drum, DrumSummary};
 use crate::engine::{Stage, StageTimes};
 use crate::world::World;
+pub use clock::{Due, OutputClock};
 use drum::DrumOutput;
 pub use resume::OutputCursor;
 use vtk::Collection;
@@ -192,15 +194,10 @@ pub struct RunOutput {
     fluid: Collection,
     walls_csv: BufWriter<File>,
     series_csv: BufWriter<File>,
-    frame_interval: Option<Real>,
-    csv_interval: Option<Real>,
-    next_frame: Real,
-    next_row: Real,
-    last_row: Real,
+    clock: OutputClock,
     /// Per wall: impulse, angular impulse, work delivered, since the last row.
     impulses: Vec<[Vector3<Real>; 2]>,
     work: Vec<Real>,
-    rows: usize,
     last_frame: Option<Real>,
     drum: Option<DrumOutput>,
 }
@@ -238,14 +235,9 @@ impl RunOutput {
             fluid: Collection::new(dir.join("fluid.pvd")),
             walls_csv,
             series_csv,
-            frame_interval,
-            csv_interval: csv_interval.or(frame_interval),
-            next_frame: world.time,
-            next_row: world.time,
-            last_row: world.time,
+            clock: OutputClock::new(frame_interval, csv_interval, world.time),
             impulses: vec![[Vector3::zeros(); 2]; world.walls.len()],
             work: vec![0.0; world.walls.len()],
-            rows: 0,
             last_frame: None,
             drum: match drum {
                 Some(d) => Some(DrumOutput::create(dir, d, world)?),
@@ -282,38 +274,28 @@ impl RunOutput {
             self.work[k] += w.power() * dt;
         }
         let t = world.time;
-        let eps = 1e-9 * dt;
         // A forced record at a time already written (the end of a run that landed on
         // a row or frame) writes nothing twice.
-        let rows_due = self.csv_interval.is_some_and(|_| t >= self.next_row - eps)
-            || (force && (t > self.last_row || self.rows == 0));
-        if rows_due {
+        let due = self.clock.due(t, dt, force);
+        if due.rows {
             self.write_rows(world, contacts)?;
-            if let Some(i) = self.csv_interval {
-                while self.next_row <= t + eps {
-                    self.next_row += i;
-                }
-            }
         }
-        if force
-            || self
-                .frame_interval
-                .is_some_and(|_| t >= self.next_frame - eps)
-        {
+        if due.frame {
             self.write_frame(world)?;
-            if let Some(i) = self.frame_interval {
-                while self.next_frame <= t + eps {
-                    self.next_frame += i;
-                }
-            }
         }
+        self.clock.advance(due, t, dt);
         Ok(())
+    }
+
+    /// When rows and frames are due.
+    pub fn clock(&self) -> &OutputClock {
+        &self.clock
     }
 
     fn write_rows(&mut self, world: &World, contacts: usize) -> io::Result<()> {
         let t = world.time;
         let max_speed = world.max_speed();
-        let span = t - self.last_row;
+        let span = t - self.clock.last_row();
         let mut row = format!("{t:.9e}");
         for (k, w) in world.walls.iter().enumerate() {
             // The first row (no interval yet) holds the instantaneous values.
@@ -344,8 +326,6 @@ impl RunOutput {
             world.kinetic_energy(),
             world.particles.frozen_count()
         )?;
-        self.last_row = t;
-        self.rows += 1;
         self.walls_csv.flush()?;
         self.series_csv.flush()
     }

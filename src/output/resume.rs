@@ -12,9 +12,9 @@ use std::path::Path;
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
-use super::RunOutput;
 use super::drum::DrumOutput;
 use super::vtk::Collection;
+use super::{OutputClock, RunOutput};
 use crate::Real;
 use crate::analysis::DrumMonitor;
 
@@ -66,6 +66,20 @@ pub(super) fn open_at(path: &Path, len: u64) -> io::Result<File> {
     Ok(file)
 }
 
+impl OutputCursor {
+    /// The clock of rows and frames where the cursor left it, with the scene's
+    /// intervals (what [`RunOutput::resume`] takes up).
+    pub fn clock(&self, frame_interval: Option<Real>, csv_interval: Option<Real>) -> OutputClock {
+        OutputClock {
+            next_frame: self.next_frame,
+            next_row: self.next_row,
+            last_row: self.last_row,
+            rows: self.rows,
+            ..OutputClock::new(frame_interval, csv_interval, 0.0)
+        }
+    }
+}
+
 impl RunOutput {
     /// Where the outputs stand now (the CSV files are flushed first).
     pub fn cursor(&mut self) -> io::Result<OutputCursor> {
@@ -79,12 +93,12 @@ impl RunOutput {
             None => None,
         };
         Ok(OutputCursor {
-            next_frame: self.next_frame,
-            next_row: self.next_row,
-            last_row: self.last_row,
+            next_frame: self.clock.next_frame,
+            next_row: self.clock.next_row,
+            last_row: self.clock.last_row,
             impulses: self.impulses.clone(),
             work: self.work.clone(),
-            rows: self.rows,
+            rows: self.clock.rows,
             last_frame: self.last_frame,
             particle_frames: self.particles.frames().to_vec(),
             wall_frames: self.walls.frames().to_vec(),
@@ -104,6 +118,7 @@ impl RunOutput {
         cursor: OutputCursor,
     ) -> io::Result<Self> {
         let c = cursor;
+        let clock = c.clock(frame_interval, csv_interval);
         if c.impulses.len() != c.work.len() {
             return Err(io::Error::new(
                 io::ErrorKind::InvalidData,
@@ -117,14 +132,9 @@ impl RunOutput {
             fluid: Collection::restore(dir.join("fluid.pvd"), c.fluid_frames)?,
             walls_csv: BufWriter::new(open_at(&dir.join("walls.csv"), c.walls_csv)?),
             series_csv: BufWriter::new(open_at(&dir.join("series.csv"), c.series_csv)?),
-            frame_interval,
-            csv_interval: csv_interval.or(frame_interval),
-            next_frame: c.next_frame,
-            next_row: c.next_row,
-            last_row: c.last_row,
+            clock,
             impulses: c.impulses,
             work: c.work,
-            rows: c.rows,
             last_frame: c.last_frame,
             drum: match c.drum {
                 Some(d) => Some(DrumOutput::resume(dir, d.monitor, d.csv)?),

@@ -17,6 +17,7 @@
 
 use super::Simulation;
 use super::energy_ledger::EnergyLedger;
+use super::ranks::RunFigures;
 use crate::Real;
 
 /// The account at a stretch's start and the scale it is judged against.
@@ -34,15 +35,13 @@ pub struct EnergyBalance {
 impl EnergyBalance {
     /// The balance of a stretch that starts now.
     pub fn start(sim: &Simulation) -> Self {
-        let w = sim.world();
         let held = sim.held_energy();
-        let mass: Real = (0..w.particles.owned())
-            .map(|i| w.body_types[w.particles.body_type[i] as usize].mass)
-            .sum();
+        let figures = sim.figures();
+        let gravity = sim.world().gravity.norm();
         EnergyBalance {
             error: sim.energy().error(held.total()),
             ledger: *sim.energy(),
-            scale: held.kinetic + held.elastic + mass * w.gravity.norm() * extent(sim),
+            scale: held.kinetic + held.elastic + figures.mass * gravity * extent(sim, &figures),
         }
     }
 
@@ -67,27 +66,19 @@ impl EnergyBalance {
     }
 }
 
-/// The diagonal of the box around the walls and the particles, m.
-fn extent(sim: &Simulation) -> Real {
-    let w = sim.world();
-    let mut lo = [Real::INFINITY; 3];
-    let mut hi = [Real::NEG_INFINITY; 3];
-    let mut add = |x: &[Real]| {
-        for k in 0..3 {
-            lo[k] = lo[k].min(x[k]);
-            hi[k] = hi[k].max(x[k]);
-        }
-    };
-    for wall in &w.walls {
+/// The diagonal of the box around the walls and the particles (whose box
+/// `figures` give), m.
+fn extent(sim: &Simulation, figures: &RunFigures) -> Real {
+    let (mut lo, mut hi) = (figures.lower, figures.upper);
+    for wall in &sim.world().walls {
         for v in &wall.vertices {
-            add((wall.pose * v).coords.as_slice());
+            let x = wall.pose * v;
+            lo = lo.inf(&x);
+            hi = hi.sup(&x);
         }
     }
-    for x in &w.particles.position[..w.particles.owned()] {
-        add(x.coords.as_slice());
-    }
-    if lo[0] > hi[0] {
+    if lo.x > hi.x {
         return 0.0;
     }
-    (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<Real>().sqrt()
+    (hi - lo).norm()
 }

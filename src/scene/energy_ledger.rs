@@ -186,7 +186,7 @@ pub struct EnergyReport {
 impl EnergyReport {
     /// The report of `sim` now.
     pub fn of(sim: &Simulation) -> Self {
-        let held = HeldEnergy::of(sim.world(), sim.stats());
+        let held = sim.held_energy();
         let ledger = *sim.energy();
         let error = ledger.error(held.total());
         let scale = ledger.scale(&held);

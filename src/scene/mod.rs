@@ -18,6 +18,8 @@ mod fluid_coupling;
 mod locate;
 mod plan;
 pub mod poses;
+mod rank_states;
+pub mod ranks;
 mod simulation;
 pub mod spec;
 pub mod state;

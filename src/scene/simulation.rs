@@ -7,6 +7,7 @@ use nalgebra::Vector3;
 
 use super::Scene;
 use super::energy_ledger::{EnergyLedger, HeldEnergy};
+use super::ranks::{RunFigures, WholeRun, bed_height_on_ranks};
 use super::spec::{FreezeSpec, SettleSpec, UpdateInterval};
 use crate::Real;
 use crate::analysis::packing::{Bed, bed_height_of};
@@ -45,6 +46,8 @@ pub struct Simulation {
     pub(super) fluid_interval: Option<UpdateInterval>,
     /// The energy account since the start.
     pub(super) energy: EnergyLedger,
+    /// On ranks: the whole run's figures after the last step (see [`super::ranks`]).
+    pub(super) whole: Option<WholeRun>,
 }
 
 /// Simulated time between two measurements of the bed height (while inlets feed
@@ -76,8 +79,20 @@ impl Simulation {
 
     /// Starts a scene at time 0 on `backend`, and evaluates the first forces.
     pub fn with_backend(scene: &Scene, backend: Box<dyn Backend>) -> Self {
-        let mut sim = Simulation {
-            world: scene.world.clone(),
+        let mut sim = Self::assemble(scene, scene.world.clone(), backend);
+        sim.backend.world_changed(&sim.world);
+        sim.insert();
+        sim.update_fluid();
+        sim.backend.initialise(&mut sim.world, sim.dt);
+        sim.energy = EnergyLedger::new(&sim.held_energy());
+        sim
+    }
+
+    /// A simulation of `scene` at the start with `world` on `backend`; nothing
+    /// inserted, nothing evaluated.
+    pub(super) fn assemble(scene: &Scene, world: World, backend: Box<dyn Backend>) -> Self {
+        Simulation {
+            world,
             backend,
             dt: scene.dt,
             inlets: scene.inlets.clone(),
@@ -91,13 +106,8 @@ impl Simulation {
             bed_height: None,
             fluid_interval: scene.spec.fluid.as_ref().map(|f| f.update_interval),
             energy: EnergyLedger::default(),
-        };
-        sim.backend.world_changed(&sim.world);
-        sim.insert();
-        sim.update_fluid();
-        sim.backend.initialise(&mut sim.world, sim.dt);
-        sim.energy = EnergyLedger::new(&sim.held_energy());
-        sim
+            whole: None,
+        }
     }
 
     /// The energy account since the start (see [`super::energy_ledger`]).
@@ -105,12 +115,29 @@ impl Simulation {
         &self.energy
     }
 
-    /// The energy the particles hold now.
+    /// The energy the particles hold now (of the whole run, on ranks).
     pub fn held_energy(&self) -> HeldEnergy {
-        HeldEnergy::of(&self.world, self.backend.stats())
+        match &self.whole {
+            Some(w) => HeldEnergy {
+                kinetic: w.figures.kinetic,
+                potential: w.figures.potential,
+                elastic: w.stats.elastic_energy,
+            },
+            None => HeldEnergy::of(&self.world, self.backend.stats()),
+        }
     }
 
-    /// The host's world (see the sync contract of [`crate::engine::backend`]).
+    /// Figures of the whole run's particles (on ranks, as of the last step).
+    pub fn figures(&self) -> RunFigures {
+        match &self.whole {
+            Some(w) => w.figures,
+            None => RunFigures::of(&self.world),
+        }
+    }
+
+    /// The host's world (see the sync contract of [`crate::engine::backend`]): on
+    /// ranks this rank's share, whose walls carry the whole run's forces and
+    /// torques (see [`Self::whole_world`] for the whole).
     pub fn world(&self) -> &World {
         &self.world
     }
@@ -120,9 +147,12 @@ impl Simulation {
         &*self.backend
     }
 
-    /// Figures of the last force evaluation.
+    /// Figures of the last force evaluation (of the whole run, on ranks).
     pub fn stats(&self) -> &StepStats {
-        self.backend.stats()
+        match &self.whole {
+            Some(w) => &w.stats,
+            None => self.backend.stats(),
+        }
     }
 
     /// Time spent in each stage of the steps so far.
@@ -266,10 +296,15 @@ impl Simulation {
         let before = self.world.time;
         self.backend.step(&mut self.world, dt);
         self.backend.sync_to_host(&mut self.world);
-        self.energy.book_step(&self.world, self.backend.stats(), dt);
         self.steps = self.steps.saturating_add(1);
-        self.follow_bed(before);
-        self.insert();
+        let freezing = self.follow_bed(before);
+        let inserted = self.insert();
+        let (inserted, freezing) = self.reduce_over_ranks(inserted, freezing);
+        // The step books other sums of the ledger than the bed and the inlets.
+        let stats = *self.stats();
+        self.energy.book_step(&self.world, &stats, dt);
+        self.energy.book_host(freezing);
+        self.energy.book_inserted(&inserted);
         if let Some(UpdateInterval::Steps(n)) = self.fluid_interval
             && self.steps % n == 0
         {
@@ -278,7 +313,15 @@ impl Simulation {
         self.update_settling();
     }
 
-    fn insert(&mut self) {
+    /// Lets the inlets insert what is due; returns the energy the particles
+    /// inserted here hold (for the ledger).
+    fn insert(&mut self) -> HeldEnergy {
+        if let Some(share) = self.backend.share() {
+            let first = self.world.particles.owned();
+            share.insert(&mut self.world, &mut self.inlets, &mut self.next_id);
+            let added = first..self.world.particles.owned();
+            return HeldEnergy::of_particles(&self.world, added);
+        }
         let first = self.world.particles.len();
         let t = self.world.time;
         for inlet in &mut self.inlets {
@@ -290,26 +333,28 @@ impl Simulation {
             p.force[i] = self.world.gravity * self.world.body_types[p.body_type[i] as usize].mass;
             p.torque[i] = Vector3::zeros();
         }
-        if p.len() > first {
-            let added = first..p.len();
-            self.energy
-                .book_inserted(&HeldEnergy::of_particles(&self.world, added.clone()));
-            self.backend.particles_added(&self.world, added);
+        let added = first..p.len();
+        if added.is_empty() {
+            return HeldEnergy::default();
         }
+        let held = HeldEnergy::of_particles(&self.world, added.clone());
+        self.backend.particles_added(&self.world, added);
+        held
     }
 
     /// Measures the bed height once per [`BED_HEIGHT_INTERVAL`] of simulated time (at
     /// its multiples, so a restored run measures when the original did) while
     /// something depends on it: stops the inlets whose bed height is reached, moves
-    /// those fed above the bed, and freezes the buried particles.
-    fn follow_bed(&mut self, before: Real) {
-        let Some(bed) = &self.bed else { return };
+    /// those fed above the bed, and freezes the buried particles. Returns the
+    /// kinetic energy the freezing took (negative), J.
+    fn follow_bed(&mut self, before: Real) -> Real {
+        let Some(bed) = &self.bed else { return 0.0 };
         let feeding = |i: &Inlet| (i.stop_height.is_some() || i.above_bed) && !i.is_done();
         if !(self.freeze.is_some() || self.inlets.iter().any(feeding))
             || (before / BED_HEIGHT_INTERVAL).floor()
                 == (self.world.time / BED_HEIGHT_INTERVAL).floor()
         {
-            return;
+            return 0.0;
         }
         // The bed: what touches something and moves slower than half of √(g d)
         // (not particles in flight, nor those sliding down the tube wall). Nothing
@@ -327,8 +372,12 @@ impl Simulation {
                 touching.get(i) == Some(&true) && p.velocity[i].norm() < 0.5 * (g * d).sqrt()
             })
             .collect();
-        let Ok(height) = bed_height_of(w, bed, &member, self.bed_height) else {
-            return;
+        let height = match self.backend.share() {
+            None => bed_height_of(w, bed, &member, self.bed_height).ok(),
+            Some(share) => bed_height_on_ranks(share, w, bed, &member, self.bed_height),
+        };
+        let Some(height) = height else {
+            return 0.0;
         };
         self.bed_height = Some(height);
         for inlet in self.inlets.iter_mut().filter(|i| feeding(i)) {
@@ -346,25 +395,45 @@ impl Simulation {
             let frozen = freeze_buried(&mut self.world, bed, freeze, height, &member);
             if !frozen.is_empty() {
                 self.backend.particles_frozen(&self.world, &frozen);
-                self.energy.book_host(self.world.kinetic_energy() - before);
+                return self.world.kinetic_energy() - before;
             }
         }
+        0.0
     }
 
-    /// Figures of the current state.
+    /// Figures of the current state (of the whole run, on ranks).
     pub fn report(&self) -> StepReport {
         StepReport {
             time: self.world.time,
-            particles: self.world.particles.owned(),
-            contacts: self.backend.stats().contacts,
+            particles: self.particle_count(),
+            contacts: self.stats().contacts,
             max_speed: self.max_speed(),
-            kinetic_energy: self.world.kinetic_energy(),
+            kinetic_energy: self.kinetic_energy(),
         }
     }
 
     /// Largest particle speed (translation).
     pub fn max_speed(&self) -> Real {
-        self.world.max_speed()
+        match &self.whole {
+            Some(w) => w.figures.max_speed,
+            None => self.world.max_speed(),
+        }
+    }
+
+    /// Kinetic energy of the particles.
+    pub fn kinetic_energy(&self) -> Real {
+        match &self.whole {
+            Some(w) => w.figures.kinetic,
+            None => self.world.kinetic_energy(),
+        }
+    }
+
+    /// Particles (owned by the ranks, on ranks).
+    pub fn particle_count(&self) -> usize {
+        match &self.whole {
+            Some(w) => w.figures.particles,
+            None => self.world.particles.owned(),
+        }
     }
 
     /// Whether every inlet has inserted all its particles.
@@ -376,6 +445,9 @@ impl Simulation {
     /// or force is not finite: the state has blown up (a time step far above the
     /// stable one).
     pub fn first_non_finite(&self) -> Option<u64> {
+        if let Some(w) = &self.whole {
+            return w.figures.non_finite;
+        }
         let p = &self.world.particles;
         if p.all_finite() {
             return None;
@@ -393,11 +465,11 @@ impl Simulation {
 
     fn update_settling(&mut self) {
         let Some(s) = &self.settle else { return };
-        let n = self.world.particles.len().max(1) as Real;
+        let n = self.particle_count().max(1) as Real;
         let quiet = self.world.time >= s.after
             && self.inlets_done()
             && self.max_speed() < s.max_speed
-            && self.world.kinetic_energy() / n < s.kinetic_energy_per_particle;
+            && self.kinetic_energy() / n < s.kinetic_energy_per_particle;
         self.quiet_since = match (quiet, self.quiet_since) {
             (true, None) => Some(self.world.time),
             (true, since) => since,

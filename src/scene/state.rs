@@ -168,6 +168,9 @@ impl Simulation {
     /// Goes back to `state` (one of this scene, see [`Simulation::check_state`]); on
     /// error nothing changed. The backend learns of it through its restore call.
     pub fn restore(&mut self, state: &SimState) -> Result<(), StateError> {
+        if self.backend.share().is_some() {
+            return Err(StateError::OnRanks);
+        }
         let inlets = self.restored_inlets(state)?;
         self.inlets = inlets;
         let world = &mut self.world;

@@ -50,6 +50,10 @@ pub enum StateError {
     /// The bytes end early or hold an impossible value.
     #[error("corrupt state: {0}")]
     Corrupt(String),
+    /// The simulation is one rank's share of a decomposed run, whose states are
+    /// not gathered and scattered yet.
+    #[error("states are not restored on MPI ranks yet")]
+    OnRanks,
     /// The checksum at the end does not match the bytes (damaged or truncated).
     #[error(
         "damaged state: its checksum is {found:#010x}, the bytes give {computed:#010x} (truncated or changed after it was written)"

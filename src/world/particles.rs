@@ -15,8 +15,9 @@ use crate::Real;
 /// elsewhere (another MPI rank's boundary layer). A ghost is felt by the owned
 /// particles it touches and is never integrated; it gets no force of its own, takes
 /// no part in wall contacts, and is left out of every output, energy and saved state.
-/// A ghost is not frozen: frozen means "part of a bed, at rest for good", and an
-/// owned particle may be frozen or not.
+/// Frozen means "part of a bed, at rest for good": an owned particle may be frozen
+/// or not, and a ghost carries its owner's flag (a ghost moves nothing here
+/// either way; the flag tells which rank counts a pair, see the CPU pair stage).
 ///
 /// # Ids
 /// Every particle has a stable id that survives reordering and keys the contact
@@ -110,6 +111,21 @@ impl Particles {
     #[inline]
     pub fn is_passive(&self, i: usize) -> bool {
         self.frozen[i] || self.is_ghost(i)
+    }
+
+    /// Whether this world counts the pair `[i, j]` (`i` of the smaller id) in its
+    /// totals and keeps its history for a saved state. One process counts every
+    /// pair. On a rank, a pair of an owned particle and a ghost is held by both
+    /// ranks; it counts where its first particle is owned, unless that one is
+    /// frozen: its rank then skips the pair (a frozen particle and a ghost move
+    /// nothing there), and the rank that owns the second counts it. So the
+    /// totals of all ranks add up to one process's.
+    pub fn counts_pair(&self, i: usize, j: usize) -> bool {
+        if self.is_ghost(i) {
+            self.frozen[i] && !self.is_ghost(j)
+        } else {
+            !(self.frozen[i] && self.is_ghost(j))
+        }
     }
 
     /// The entry of the particle with `id`, if present.

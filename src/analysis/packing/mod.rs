@@ -396,13 +396,19 @@ pub fn bed_height_of(
     member: &[bool],
     last: Option<Real>,
 ) -> Result<Real, String> {
-    let from = last.map_or(Real::NEG_INFINITY, |h| {
-        h - FEED_WINDOW * largest_diameter(world)
-    });
+    let from = measured_from(world, last);
     let placed = Placed::new(world, bed, |i| {
         member.get(i) == Some(&true) && bed.tube.top_of(world, i) > from
     })?;
     Ok(placed.axial_above(from).1)
+}
+
+/// The level above which [`bed_height_of`] integrates a bed last measured at
+/// `last`: a particle whose top lies below it takes no part.
+pub fn measured_from(world: &World, last: Option<Real>) -> Real {
+    last.map_or(Real::NEG_INFINITY, |h| {
+        h - FEED_WINDOW * largest_diameter(world)
+    })
 }
 
 /// Depth of the part of a bed that [`bed_height_of`] integrates, in particle

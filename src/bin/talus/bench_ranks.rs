@@ -4,8 +4,9 @@
 //! and bisected again by cost at a renewal where the imbalance passes 1.1.
 //!
 //! Rank 0 prints one row: the particles, the ghosts per owned particle, the
-//! contacts summed over the ranks (a pair across a boundary is evaluated, and
-//! counted, on both of its ranks), particle-steps per second of the slowest rank,
+//! contacts summed over the ranks (a pair across a boundary is evaluated on both of
+//! its ranks and counted on one: one process's count), particle-steps per second of
+//! the slowest rank,
 //! the bytes every rank sent to the others per step, and the share of the step
 //! the ranks spent in the exchange (the transfer and the wait for the slowest rank;
 //! mean and largest over ranks). Every particle moves to the bits of one process
@@ -14,11 +15,11 @@
 
 use std::time::Instant;
 
-use anyhow::{Result, anyhow};
+use anyhow::Result;
 use talus::engine::decomposition::Decomposition;
 use talus::engine::exchange::Exchange;
 use talus::engine::metered_exchange::MeteredExchange;
-use talus::engine::mpi_exchange::MpiExchange;
+use talus::engine::mpi_exchange;
 use talus::engine::rank::RankStepper;
 use talus::engine::{Backend, ContactHistory};
 use talus::scene::Scene;
@@ -36,8 +37,8 @@ pub fn ranks(options: &BenchOptions) -> Result<()> {
     rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build_global()?;
-    let universe = mpi::initialize().ok_or_else(|| anyhow!("MPI was initialised already"))?;
-    let exchange = MeteredExchange::new(MpiExchange::new(universe.world()));
+    let (_universe, exchange) = mpi_exchange::start()?;
+    let exchange = MeteredExchange::new(exchange);
     let (rank, size) = (exchange.rank(), exchange.size());
     let dir = std::env::temp_dir().join(format!("talus-bench-ranks-{}-{rank}", std::process::id()));
     std::fs::create_dir_all(&dir)?;

@@ -10,6 +10,7 @@ mod checkpoint;
 mod contact;
 mod expected;
 mod fmu;
+mod launch;
 mod run;
 #[cfg(feature = "zenoh")]
 mod serve;

@@ -2,6 +2,7 @@
 //! progress, ParaView output, CSV series and a summary; checkpoints on the way, and
 //! resumption from them.
 
+use std::borrow::Cow;
 use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -12,12 +13,13 @@ use anyhow::{Context, Result, bail};
 use indicatif::{ProgressBar, ProgressStyle};
 use talus::Real;
 use talus::checkpoint::{Checkpoint, RunProgress};
-use talus::output::{EnergySummary, RunOutput, StageSummary, Summary, WallSummary};
+use talus::output::{EnergySummary, OutputClock, RunOutput, StageSummary, Summary, WallSummary};
 use talus::scene::energy_balance::EnergyBalance;
 use talus::scene::energy_ledger::EnergyReport;
 use talus::scene::spec::UpdateInterval;
 use talus::scene::{Scene, Simulation};
 
+use crate::launch::Launch;
 use crate::{checkpoint, expected};
 
 /// Loads a scene, printing its warnings.
@@ -75,7 +77,11 @@ pub fn run(path: Option<&Path>, options: RunOptions) -> Result<()> {
             scene.file.display()
         );
     }
-    let (pool, threads) = worker_pool(options.threads, &scene)?;
+    let mut launch = Launch::detect()?;
+    if launch.is_rank() {
+        refuse_on_ranks(&scene)?;
+    }
+    let (pool, threads) = worker_pool_of(options.threads, &scene, launch.local_ranks())?;
     let stop = Arc::new(AtomicBool::new(false));
     {
         let stop = stop.clone();
@@ -88,7 +94,29 @@ pub fn run(path: Option<&Path>, options: RunOptions) -> Result<()> {
         .context("cannot install the Ctrl-C handler")?;
     }
     let checkpoints = Checkpoints::new(&scene, &dir, options.checkpoint_every, threads);
-    pool.install(|| run_loop(&scene, &dir, start, checkpoints, &stop, options.quiet))
+    let quiet = options.quiet || !launch.is_root();
+    pool.install(|| {
+        let sim = match &start {
+            None => launch.simulation(&scene)?,
+            Some(c) => launch
+                .restored(&scene, &c.sim)
+                .context("the checkpoint does not fit its scene")?,
+        };
+        run_loop(&scene, &dir, sim, start, checkpoints, &stop, quiet)
+    })
+    .map_err(|e| launch.fail(e))
+}
+
+/// What `talus run` does not do on MPI ranks yet.
+fn refuse_on_ranks(scene: &Scene) -> Result<()> {
+    let file = scene.file.display();
+    if scene.drum.is_some() {
+        bail!(
+            "{file}: the drum's analysis ([drum]) does not run on MPI ranks yet (it reads the \
+             whole bed every step); run in one process"
+        );
+    }
+    Ok(talus::scene::ranks::check_on_ranks(scene)?)
 }
 
 /// Steps between two checks of the energy balance (see
@@ -120,23 +148,34 @@ impl Checkpoints {
         }
     }
 
-    /// Whether a checkpoint is due after a step of length `dt` that ended at `t`: at
-    /// each multiple of the interval, and after `every` of wall-clock time.
-    fn due(&self, t: Real, dt: Real) -> bool {
+    /// Whether a checkpoint is due after a step of length `dt`: at each multiple
+    /// of the interval, and after `every` of wall-clock time (on ranks, as rank 0's
+    /// clock says, asked every [`STOP_VOTE_STEPS`] steps: all ranks write together).
+    fn due(&self, sim: &Simulation, dt: Real) -> bool {
+        let t = sim.time();
         let crossed = self.interval.is_some_and(|i| {
             let eps = 1e-9 * dt;
             ((t + eps) / i).floor() > ((t - dt + eps) / i).floor()
         });
-        crossed || self.every.is_some_and(|e| self.last.elapsed() >= e)
+        let late = |every: Duration| self.last.elapsed() >= every;
+        crossed
+            || match (sim.rank(), self.every) {
+                (_, None) => false,
+                (None, Some(every)) => late(every),
+                (Some((rank, _)), Some(every)) => {
+                    sim.steps % STOP_VOTE_STEPS == 0 && sim.any_rank(rank == 0 && late(every))
+                }
+            }
     }
 
-    /// Writes one of the simulation and the outputs as they are now.
-    fn write(
-        &mut self,
-        sim: &Simulation,
-        out: &mut RunOutput,
-        progress: RunProgress,
-    ) -> Result<()> {
+    /// Writes one of the simulation and the outputs as they are now (collective on
+    /// ranks: the state is gathered on rank 0, which writes it).
+    fn write(&mut self, sim: &Simulation, out: &mut Outputs, progress: RunProgress) -> Result<()> {
+        let state = sim.whole_snapshot();
+        self.last = Instant::now();
+        let (Some(state), Some(out)) = (state, &mut out.out) else {
+            return Ok(());
+        };
         let checkpoint = Checkpoint {
             scene: self.scene.clone(),
             progress: RunProgress {
@@ -144,44 +183,61 @@ impl Checkpoints {
                 ..progress
             },
             output: out.cursor()?,
-            sim: sim.snapshot(),
+            sim: state,
         };
         checkpoint::write(&self.dir, &checkpoint.to_bytes(self.fingerprint))
-            .with_context(|| format!("cannot write a checkpoint in {}", self.dir.display()))?;
-        self.last = Instant::now();
-        Ok(())
+            .with_context(|| format!("cannot write a checkpoint in {}", self.dir.display()))
     }
 }
 
+/// Steps between two votes of the ranks on whether the run was interrupted (on
+/// ranks every rank must stop at the same step): a Ctrl-C is answered within them.
+const STOP_VOTE_STEPS: u64 = 64;
+
+/// Steps `sim` (the whole scene, or this rank's share of it) to the end; `quiet`:
+/// no progress and no messages (every rank but 0).
 fn run_loop(
     scene: &Scene,
     dir: &Path,
+    mut sim: Simulation,
     start: Option<Checkpoint>,
     mut checkpoints: Checkpoints,
     stop: &AtomicBool,
     quiet: bool,
 ) -> Result<()> {
-    let mut sim = Simulation::new(scene);
+    let root = sim.rank().is_none_or(|(rank, _)| rank == 0);
     let frame_interval = scene.spec.output.frame_interval;
     let csv_interval = scene.spec.output.csv_interval;
     let (mut out, before) = match start {
         None => {
-            let mut out = RunOutput::create(
-                dir,
-                sim.world(),
-                frame_interval,
-                csv_interval,
-                scene.drum.as_ref(),
-            )
-            .with_context(|| format!("cannot write to {}", dir.display()))?;
-            out.record(sim.world(), 0.0, sim.stats().contacts, true)?;
+            let out = if root {
+                let out = RunOutput::create(
+                    dir,
+                    sim.world(),
+                    frame_interval,
+                    csv_interval,
+                    scene.drum.as_ref(),
+                )
+                .with_context(|| format!("cannot write to {}", dir.display()))?;
+                Some(out)
+            } else {
+                None
+            };
+            let clock = OutputClock::new(frame_interval, csv_interval, sim.time());
+            let mut out = Outputs { out, clock };
+            out.record(&sim, 0.0, true)?;
             (out, RunProgress::default())
         }
         Some(c) => {
-            sim.restore(&c.sim)
-                .context("the checkpoint does not fit its scene")?;
-            let out = RunOutput::resume(dir, frame_interval, csv_interval, c.output)
-                .with_context(|| format!("cannot take up the outputs in {}", dir.display()))?;
+            let clock = c.output.clock(frame_interval, csv_interval);
+            let out = if root {
+                let out = RunOutput::resume(dir, frame_interval, csv_interval, c.output)
+                    .with_context(|| format!("cannot take up the outputs in {}", dir.display()))?;
+                Some(out)
+            } else {
+                None
+            };
+            let out = Outputs { out, clock };
             if !quiet {
                 eprintln!(
                     "resuming at t = {:.6e} s after {} steps from {}",
@@ -193,7 +249,11 @@ fn run_loop(
             (out, c.progress)
         }
     };
-    let impacts = expected::measure(scene);
+    let impacts = if root {
+        expected::measure(scene)
+    } else {
+        Vec::new()
+    };
     if !quiet {
         eprint!("{}", expected::describe(scene, &impacts));
     }
@@ -218,8 +278,12 @@ fn run_loop(
     };
     let mut last_draw = Instant::now();
     // What ends a run, in this order: Ctrl-C, the end time, the settling criterion.
+    let interrupted = |sim: &Simulation| match sim.rank() {
+        None => stop.load(Ordering::SeqCst),
+        Some(_) => sim.steps % STOP_VOTE_STEPS == 0 && sim.any_rank(stop.load(Ordering::SeqCst)),
+    };
     let stopped = |sim: &Simulation| {
-        if stop.load(Ordering::SeqCst) {
+        if interrupted(sim) {
             Some("interrupted")
         } else if !sim.is_finished() && sim.is_settled() {
             Some("settled")
@@ -267,10 +331,10 @@ fn run_loop(
                 let stats = sim.stats();
                 particle_steps += stats.integrated as u64;
                 contact_sum += stats.contacts as u64;
-                if let Err(e) = out.record(sim.world(), taken, stats.contacts, false) {
-                    return ControlFlow::Break(Err(e.into()));
+                if let Err(e) = out.record(sim, taken, false) {
+                    return ControlFlow::Break(Err(e));
                 }
-                if checkpoints.due(sim.time(), taken)
+                if checkpoints.due(sim, taken)
                     && let Err(e) =
                         checkpoints.write(sim, &mut out, progress(contact_sum, particle_steps))
                 {
@@ -282,7 +346,7 @@ fn run_loop(
                     bar.set_message(format!(
                         "{:.4e} s | {} particles | {} contacts | energy error {:+.1e}",
                         sim.time(),
-                        sim.world().particles.owned(),
+                        sim.particle_count(),
                         stats.contacts,
                         EnergyReport::of(sim).relative_error
                     ));
@@ -302,15 +366,30 @@ fn run_loop(
     if ended_by == "interrupted" {
         // Before the last frame and row, which an uninterrupted run would not write.
         checkpoints.write(&sim, &mut out, progress(contact_sum, particle_steps))?;
-        eprintln!(
-            "interrupted at t = {:.6e} s; continue with: talus run --resume {}",
-            sim.time(),
-            dir.display()
-        );
+        if root {
+            eprintln!(
+                "interrupted at t = {:.6e} s; continue with: {}talus run --resume {}",
+                sim.time(),
+                sim.rank()
+                    .map_or(String::new(), |(_, n)| format!("mpirun -np {n} ")),
+                dir.display()
+            );
+        }
     }
     if blown_up.is_none() {
-        out.record(sim.world(), 0.0, sim.stats().contacts, true)?;
+        out.record(&sim, 0.0, true)?;
     }
+    // Every rank takes part in gathering the bed; rank 0 writes.
+    let bed_world = match &scene.bed {
+        Some(_) => sim.whole_world(),
+        None => None,
+    };
+    let Some(mut out) = out.out else {
+        return match blown_up {
+            Some(message) => bail!("{}: the run diverged: {message}", scene.file.display()),
+            None => Ok(()),
+        };
+    };
     let drum = out.finish(sim.world())?;
     let elapsed = before.wall_clock_s + started.elapsed().as_secs_f64();
     let mut summary = summary(
@@ -331,8 +410,8 @@ fn run_loop(
     if let Some(message) = blown_up {
         anyhow::bail!("{}: the run diverged: {message}", scene.file.display());
     }
-    if let Some(bed) = &scene.bed {
-        crate::analyze::write_bed_files(scene, bed, sim.world(), dir)?;
+    if let (Some(bed), Some(world)) = (&scene.bed, &bed_world) {
+        crate::analyze::write_bed_files(scene, bed, world, dir)?;
     }
     println!(
         "{}: {} at t = {:.6e} s after {} steps in {:.2} s ({:.3e} particle-steps/s, {:.3e} contacts/s); {} particles; energy error {:+.2e} of {:.3e} J dissipated; output in {}",
@@ -353,6 +432,33 @@ fn run_loop(
         dir.display()
     );
     Ok(())
+}
+
+/// The outputs of a run: written by rank 0 (or the one process); every rank keeps
+/// the clock, since gathering the whole world for a row or a frame is collective.
+struct Outputs {
+    out: Option<RunOutput>,
+    clock: OutputClock,
+}
+
+impl Outputs {
+    /// [`RunOutput::record`] after a step of length `dt`, the whole world gathered
+    /// when a row or a frame is due.
+    fn record(&mut self, sim: &Simulation, dt: Real, force: bool) -> Result<()> {
+        let due = self.clock.due(sim.time(), dt, force);
+        self.clock.advance(due, sim.time(), dt);
+        // Between rows and frames only the walls are read, whose forces are the
+        // whole run's on every rank.
+        let world = if due.any() {
+            sim.whole_world()
+        } else {
+            Some(Cow::Borrowed(sim.world()))
+        };
+        if let (Some(out), Some(world)) = (&mut self.out, world) {
+            out.record(&world, dt, sim.stats().contacts, force)?;
+        }
+        Ok(())
+    }
 }
 
 /// What a run counted over all its stretches.
@@ -387,7 +493,7 @@ fn summary(
         steps: sim.steps,
         wall_clock_s: totals.elapsed,
         particles: report.particles,
-        frozen: sim.world().particles.frozen_count(),
+        frozen: sim.figures().frozen,
         contacts: report.contacts,
         candidate_pairs: sim.stats().candidate_pairs,
         particle_steps_per_s: totals.particle_steps as f64 / elapsed,
@@ -432,8 +538,21 @@ fn energy_summary(r: &EnergyReport) -> EnergySummary {
 /// The worker threads of a command: `threads` if given (not 0), else the scene's
 /// `[simulation] threads`, else all cores.
 pub fn worker_pool(threads: usize, scene: &Scene) -> Result<(rayon::ThreadPool, usize)> {
+    worker_pool_of(threads, scene, 1)
+}
+
+/// [`worker_pool`] of one of `processes` processes on this machine, which share
+/// its cores when neither the command nor the scene set the threads.
+fn worker_pool_of(
+    threads: usize,
+    scene: &Scene,
+    processes: usize,
+) -> Result<(rayon::ThreadPool, usize)> {
     let threads = match (threads, scene.spec.simulation.threads) {
-        (0, 0) => std::thread::available_parallelism().map_or(1, |n| n.get()),
+        (0, 0) => {
+            let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+            (cores / processes.max(1)).max(1)
+        }
         (0, t) | (t, _) => t,
     };
     let pool = rayon::ThreadPoolBuilder::new()

@@ -138,7 +138,7 @@ impl CpuBackend {
         let totals = times.time(Stage::Gather, || {
             pairs::gather(world, list, &work.results, &mut work.touching)
         });
-        let pair_contacts = totals.contacts;
+        let (pair_contacts, candidate_pairs) = (totals.contacts, totals.candidates);
         let totals = times.time(Stage::WallContacts, || {
             let inputs = WallInputs {
                 list,
@@ -161,7 +161,7 @@ impl CpuBackend {
         stats.elastic_energy = totals.energy;
         stats.dissipated = totals.dissipated;
         stats.fluid_work = fluid_work;
-        stats.candidate_pairs = list.pairs().len();
+        stats.candidate_pairs = candidate_pairs;
         stats.list_builds = list.builds();
     }
 }

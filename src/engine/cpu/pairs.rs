@@ -194,8 +194,13 @@ pub(super) fn gather(
                 *torque += c.torques[role];
             }
         });
+    let p = &world.particles;
     let mut totals = ContactTotals::default();
-    for c in results {
+    for (c, &[i, j]) in results.iter().zip(list.pairs()) {
+        if !p.counts_pair(i as usize, j as usize) {
+            continue;
+        }
+        totals.candidates += 1;
         totals.contacts += usize::from(c.touching);
         totals.energy += c.energy;
         totals.dissipated += c.dissipated;
@@ -207,6 +212,8 @@ pub(super) fn gather(
 /// particle order.
 #[derive(Clone, Copy, Debug, Default)]
 pub(super) struct ContactTotals {
+    /// Candidate pairs (of the pair stage).
+    pub candidates: usize,
     pub contacts: usize,
     /// Elastic energy held in the contacts, J.
     pub energy: Real,

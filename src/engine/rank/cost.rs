@@ -16,17 +16,21 @@ pub const PARTICLE_COST: Real = 0.3;
 
 /// Each owned particle's share of a step's cost, in sphere pairs: its own cost and
 /// half of each of its candidate pairs (a pair of two spheres 1, else
-/// [`POLYHEDRON_PAIR_COST`]).
+/// [`POLYHEDRON_PAIR_COST`]). `list` may be older than the world: particles
+/// inserted since have no pairs yet (and the ghosts after them moved up by as
+/// many places, which may misjudge a pair's kind, not its count).
 pub fn particle_costs(world: &World, list: &NeighbourList) -> Vec<Real> {
     let p = &world.particles;
     let is_sphere = |i: usize| {
-        world.body_types[p.body_type[i] as usize]
-            .shape
-            .as_polyhedron()
-            .is_none()
+        p.body_type
+            .get(i)
+            .is_some_and(|&t| world.body_types[t as usize].shape.as_polyhedron().is_none())
     };
     (0..p.owned())
         .map(|i| {
+            if i >= list.particle_count() {
+                return PARTICLE_COST;
+            }
             let pairs: Real = list
                 .incident(i)
                 .iter()

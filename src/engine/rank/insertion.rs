@@ -23,7 +23,7 @@ impl<E: Exchange> RankStepper<E> {
     /// first half kick, as in one process. Returns the particles placed on all
     /// ranks. Inlets that follow the bed (`stop_height`, `above_bed`) are moved
     /// by the caller from the whole run's bed height, as `Simulation` does.
-    pub fn insert(&mut self, world: &mut World, inlets: &mut [Inlet], next_id: &mut u64) -> usize {
+    pub fn insert(&self, world: &mut World, inlets: &mut [Inlet], next_id: &mut u64) -> usize {
         let (t, me, size) = (world.time, self.exchange.rank(), self.exchange.size());
         let mut placed_here_and_there = 0;
         for inlet in inlets.iter_mut().filter(|inlet| inlet.is_due(t)) {

@@ -30,16 +30,20 @@ use super::decomposition::Decomposition;
 use super::exchange::Exchange;
 use super::neighbours::automatic_skin;
 use super::params::StepParams;
+use super::stats::StepStats;
 use crate::Real;
 use crate::world::World;
 
+mod backend;
 mod cost;
 mod insertion;
 mod records;
+mod share;
 
 pub use cost::{PARTICLE_COST, POLYHEDRON_PAIR_COST, particle_costs};
 pub use records::ParticleRecord;
 use records::{Migrant, history_of};
+pub use share::{Share, all_gather, gather_to_first};
 
 /// Steps one rank's share of a decomposed world.
 ///
@@ -77,10 +81,34 @@ impl<E: Exchange> RankStepper<E> {
     pub fn new(
         exchange: E,
         decomposition: Decomposition,
-        mut params: StepParams,
+        params: StepParams,
         world: &mut World,
         history: &ContactHistory,
         dt: Real,
+    ) -> Self {
+        let mut rank = Self::restored(
+            exchange,
+            decomposition,
+            params,
+            world,
+            history,
+            StepStats::default(),
+        );
+        rank.backend.initialise(world, dt);
+        rank
+    }
+
+    /// Takes this rank's share of a restored `world` as [`RankStepper::new`] does,
+    /// but as one process's restore takes a state: the owned particles keep the
+    /// forces `world` holds (those of the step that ended), and `stats` are the last
+    /// figures, so the next step continues the saved run to the bit.
+    pub fn restored(
+        exchange: E,
+        decomposition: Decomposition,
+        mut params: StepParams,
+        world: &mut World,
+        history: &ContactHistory,
+        stats: StepStats,
     ) -> Self {
         assert_eq!(exchange.size(), decomposition.ranks(), "one box per rank");
         // Every rank holds the whole world here: its own radii are everyone's.
@@ -124,9 +152,7 @@ impl<E: Exchange> RankStepper<E> {
                 .collect(),
         };
         rank.choose_ghosts(world);
-        let stats = *rank.backend.stats();
         rank.backend.restore(world, mine, stats);
-        rank.backend.initialise(world, dt);
         rank
     }
 
@@ -195,7 +221,10 @@ impl<E: Exchange> RankStepper<E> {
         let received = self.send_ghost_states(world);
         let p = &mut world.particles;
         for (k, record) in received.iter().flatten().enumerate() {
-            record.set_motion(p, p.owned() + k);
+            let i = p.owned() + k;
+            record.set_motion(p, i);
+            // Frozen between steps by the host's bed measurement.
+            p.frozen[i] = record.frozen;
         }
     }
 
@@ -249,12 +278,7 @@ impl<E: Exchange> RankStepper<E> {
         let mut pairs: BTreeMap<_, _> = history.pairs.into_iter().collect();
         let mut walls: BTreeMap<_, _> = history.walls.into_iter().collect();
         for m in arrived.into_iter().flatten() {
-            let r = &m.particle;
-            let p = &mut world.particles;
-            p.push(r.body_type, r.position, r.orientation, r.id);
-            let i = p.owned() - 1;
-            r.set_motion(p, i);
-            p.frozen[i] = r.frozen;
+            m.particle.push_into(&mut world.particles);
             pairs.extend(m.history.pairs);
             walls.extend(m.history.walls);
             self.migrated += 1;
@@ -337,6 +361,7 @@ impl<E: Exchange> RankStepper<E> {
             p.push_ghost(r.body_type, r.position, r.orientation, r.id);
             let i = p.len() - 1;
             r.set_motion(p, i);
+            p.frozen[i] = r.frozen;
         }
     }
 }

@@ -28,7 +28,8 @@ pub struct ParticleRecord {
 }
 
 impl ParticleRecord {
-    pub(super) fn of(p: &Particles, i: usize) -> Self {
+    /// Particle `i`'s state.
+    pub fn of(p: &Particles, i: usize) -> Self {
         ParticleRecord {
             id: p.id[i],
             body_type: p.body_type[i],
@@ -38,6 +39,14 @@ impl ParticleRecord {
             velocity: p.velocity[i],
             angular_momentum: p.angular_momentum[i],
         }
+    }
+
+    /// Appends it to the owned particles.
+    pub fn push_into(&self, p: &mut Particles) {
+        p.push(self.body_type, self.position, self.orientation, self.id);
+        let i = p.owned() - 1;
+        self.set_motion(p, i);
+        p.frozen[i] = self.frozen;
     }
 
     /// Writes the motion state into entry `i`.

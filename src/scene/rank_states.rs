@@ -1,0 +1,135 @@
+//! Saved states of a run on ranks: the whole run's state gathered on rank 0, the
+//! same state as one process saves (particles in id order, contact history sorted
+//! by key), so that a state saved by N ranks restores on M ranks or in one process,
+//! and one saved by one process restores on ranks.
+
+use std::fmt;
+
+use nalgebra::Vector3;
+
+use super::Scene;
+use super::Simulation;
+use super::energy_ledger::HeldEnergy;
+use super::ranks::{
+    REBALANCE_ABOVE, RanksError, check_on_ranks, seeds_of, spread_facet_forces, sum_facet_forces,
+};
+use super::state::SimState;
+use crate::Real;
+use crate::engine::decomposition::Decomposition;
+use crate::engine::exchange::Exchange;
+use crate::engine::rank::{ParticleRecord, RankStepper, gather_to_first};
+use crate::engine::{ContactHistory, CpuBackend};
+use crate::world::Particles;
+
+/// A particle as a saved state holds it: its state, and the force and torque of
+/// the step that ended (the next half kick's).
+type SavedParticle = (ParticleRecord, (Vector3<Real>, Vector3<Real>));
+
+impl Simulation {
+    /// The whole run's state: in one process [`Simulation::snapshot`]; on ranks
+    /// (collective) gathered on rank 0, and `None` on the others.
+    pub fn whole_snapshot(&self) -> Option<SimState> {
+        let Some(share) = self.backend.share() else {
+            return Some(self.snapshot());
+        };
+        let p = &self.world.particles;
+        let particles: Vec<SavedParticle> = (0..p.owned())
+            .map(|i| (ParticleRecord::of(p, i), (p.force[i], p.torque[i])))
+            .collect();
+        // A pair's history from the one rank that counts it (the other may hold a
+        // stale copy); a patch's from its particle's owner.
+        let held = self.backend.contact_history();
+        let counted = |a: u64, b: u64| match (p.index_of(a), p.index_of(b)) {
+            (Some(i), Some(j)) => p.counts_pair(i, j),
+            _ => false,
+        };
+        let mine = ContactHistory {
+            pairs: held
+                .pairs
+                .into_iter()
+                .filter(|((a, b), _)| counted(*a, *b))
+                .collect(),
+            walls: held
+                .walls
+                .into_iter()
+                .filter(|(key, _)| p.index_of(key.0).is_some_and(|i| !p.is_ghost(i)))
+                .collect(),
+        };
+        let particles = gather_to_first(share, &particles);
+        let histories = gather_to_first(share, &[mine]);
+        let facets = sum_facet_forces(share, &self.world);
+        if share.rank() != 0 {
+            return None;
+        }
+        let mut state = self.snapshot();
+        state.stats = *self.stats();
+        state.particles = saved_particles(particles.into_iter().flatten().collect());
+        let mut history = ContactHistory::default();
+        for h in histories.into_iter().flatten() {
+            history.pairs.extend(h.pairs);
+            history.walls.extend(h.walls);
+        }
+        history.pairs.sort_unstable_by_key(|e| e.0);
+        history.walls.sort_unstable_by_key(|e| e.0);
+        state.history = history;
+        spread_facet_forces(&facets, state.walls.iter_mut().map(|w| &mut w.facet_force));
+        Some(state)
+    }
+
+    /// A run of `scene` on the ranks of `exchange` that continues from `state` (the
+    /// whole run's, as [`Simulation::whole_snapshot`] or one process saved it;
+    /// every rank passes the same): each rank keeps its share, the particles with
+    /// the saved forces, and the next step continues the saved run to the bit.
+    pub fn on_ranks_from<E: Exchange + Send + fmt::Debug + 'static>(
+        scene: &Scene,
+        exchange: E,
+        state: &SimState,
+    ) -> Result<Self, RanksError> {
+        check_on_ranks(scene)?;
+        let params = scene.step_params();
+        let mut sim = Simulation::assemble(
+            scene,
+            scene.world.clone(),
+            Box::new(CpuBackend::new(params)),
+        );
+        sim.restore(state)?;
+        let mut world = sim.world.clone();
+        let seeds = seeds_of(&world);
+        let layout = Decomposition::bisect(&seeds, &vec![1.0; seeds.len()], exchange.size());
+        let stepper = RankStepper::restored(
+            exchange,
+            layout,
+            params,
+            &mut world,
+            &state.history,
+            Default::default(),
+        )
+        .rebalance_above(REBALANCE_ABOVE);
+        sim.world = world;
+        sim.backend = Box::new(stepper);
+        sim.reduce_over_ranks(HeldEnergy::default(), 0.0);
+        // The walls and figures of the step that ended, as saved (the ranks' own
+        // start from nothing).
+        for (wall, saved) in sim.world.walls.iter_mut().zip(&state.walls) {
+            wall.force = saved.force;
+            wall.torque = saved.torque;
+        }
+        if let Some(whole) = &mut sim.whole {
+            whole.stats = state.stats;
+        }
+        Ok(sim)
+    }
+}
+
+/// Particles as a saved state holds them, in id order.
+fn saved_particles(mut saved: Vec<SavedParticle>) -> Particles {
+    saved.sort_unstable_by_key(|(r, _)| r.id);
+    let mut p = Particles::default();
+    for (r, (force, torque)) in &saved {
+        r.push_into(&mut p);
+        let i = p.owned() - 1;
+        p.force[i] = *force;
+        p.torque[i] = *torque;
+    }
+    p
+}

@@ -1,0 +1,377 @@
+//! `mpirun -np N talus run` (feature `mpi`): the ranks split the scene and write one
+//! output set, the one a single process writes (a box poured from an inlet; a bed
+//! fed from a box riding above it, its buried particles frozen, and its packing
+//! analysed); checkpoints written by N ranks resume on M ranks or in one process; a
+//! SIGTERM to mpirun ends every rank with the outputs written; what the ranks
+//! cannot do yet is refused with a message.
+//!
+//! Particles move to the bits of one process, so the frames (positions,
+//! orientations, velocities) and `series.csv` (counts, kinetic energy, largest
+//! speed: sums of the same bits in the same order on rank 0's gathered world) are
+//! the same bytes. Wall forces are summed over ranks in another grouping than one
+//! process's sum over particles: they agree to round-off, about 1e-15 relative,
+//! which may change the tenth significant digit the CSV prints.
+#![cfg(feature = "mpi")]
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use std::time::{Duration, Instant};
+
+/// The settling box of the examples, poured from its inlet for `end_time`.
+fn settling_box(dir: &Path, end_time: f64) -> PathBuf {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/settling_box/scene.toml");
+    let text = std::fs::read_to_string(path).expect("the example is shipped");
+    let text = text.replace("end_time = 0.6", &format!("end_time = {end_time}"));
+    std::fs::create_dir_all(dir).unwrap();
+    let scene = dir.join("box.toml");
+    std::fs::write(&scene, text).unwrap();
+    scene
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("talus-mpi-run-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    dir
+}
+
+/// `talus` with `args` under `mpirun -np ranks` (more ranks than cores allowed; as
+/// root with OpenMPI's consent variables).
+fn mpirun(ranks: usize, args: &[&str]) -> Command {
+    let mut c = Command::new("mpirun");
+    c.args(["--oversubscribe", "-np", &ranks.to_string()])
+        .arg(env!("CARGO_BIN_EXE_talus"))
+        .args(args)
+        .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
+        .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1");
+    c
+}
+
+fn text(out: &Output) -> String {
+    format!(
+        "{}\n{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    )
+}
+
+fn read(path: &Path) -> Vec<u8> {
+    std::fs::read(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
+
+fn summary(dir: &Path) -> serde_json::Value {
+    serde_json::from_slice(&read(&dir.join("summary.json"))).unwrap()
+}
+
+/// Runs `scene` in one process into `dir/one` and on `ranks` ranks into
+/// `dir/ranks` (one thread each); returns the two directories.
+fn run_both(scene: &Path, dir: &Path, ranks: usize) -> (PathBuf, PathBuf) {
+    let scene = scene.to_str().unwrap();
+    let (one, many) = (dir.join("one"), dir.join("ranks"));
+    let out = Command::new(env!("CARGO_BIN_EXE_talus"))
+        .args(["run", scene, "--quiet", "--threads", "1", "--out"])
+        .arg(&one)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", text(&out));
+    let out = mpirun(ranks, &["run", scene, "--quiet", "--threads", "1", "--out"])
+        .arg(&many)
+        .output()
+        .expect("mpirun (openmpi-bin, scripts/system-deps.sh)");
+    assert!(out.status.success(), "{}", text(&out));
+    // One summary line, from rank 0.
+    let said = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(said.matches("finished at").count(), 1, "{said}");
+    (one, many)
+}
+
+/// The frames (at least `frames` of particles and walls) and `files` of both
+/// directories are the same bytes.
+fn assert_same_bytes(one: &Path, many: &Path, frames: usize, files: &[&str]) {
+    let listed = |d: &Path| -> Vec<_> {
+        let mut names: Vec<_> = std::fs::read_dir(d.join("frames"))
+            .unwrap()
+            .map(|e| e.unwrap().file_name())
+            .collect();
+        names.sort();
+        names
+    };
+    let names = listed(one);
+    assert_eq!(names, listed(many));
+    assert!(names.len() >= 2 * frames, "{names:?}");
+    for f in &names {
+        let (a, b) = (
+            read(&one.join("frames").join(f)),
+            read(&many.join("frames").join(f)),
+        );
+        assert!(a == b, "{f:?} differs between one process and the ranks");
+    }
+    for f in files {
+        assert!(read(&one.join(f)) == read(&many.join(f)), "{f} differs");
+    }
+}
+
+#[test]
+fn talus_run_on_three_ranks_writes_what_one_process_writes() {
+    let dir = scratch("three");
+    let scene = settling_box(&dir, 0.1);
+    let (one, three) = run_both(&scene, &dir, 3);
+    // 0.1 s at 0.02 s a frame: six frames.
+    assert_same_bytes(
+        &one,
+        &three,
+        6,
+        &["particles.pvd", "walls.pvd", "series.csv"],
+    );
+
+    // walls.csv: the same rows, each number within a few units of its printed
+    // tenth digit of the column's largest.
+    let table = |d: &Path| -> Vec<Vec<f64>> {
+        String::from_utf8(read(&d.join("walls.csv")))
+            .unwrap()
+            .lines()
+            .skip(1)
+            .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+            .collect()
+    };
+    let (a, b) = (table(&one), table(&three));
+    assert_eq!(a.len(), b.len());
+    assert!(a.len() >= 50, "a row every 2 ms: {}", a.len());
+    for col in 0..a[0].len() {
+        let largest = a.iter().map(|r| r[col].abs()).fold(0.0, f64::max);
+        for (ra, rb) in a.iter().zip(&b) {
+            assert!(
+                (ra[col] - rb[col]).abs() <= 1e-9 * largest,
+                "walls.csv column {col} at t = {}: {} against {}",
+                ra[0],
+                ra[col],
+                rb[col]
+            );
+        }
+    }
+
+    let (s1, s3) = (summary(&one), summary(&three));
+    for key in [
+        "ended_by",
+        "steps",
+        "particles",
+        "frozen",
+        "contacts",
+        "candidate_pairs",
+        "frames",
+    ] {
+        assert_eq!(s1[key], s3[key], "summary.json {key}");
+    }
+    assert_eq!(s1["particles"], 200);
+    let close = |key: &str, part: Option<&str>| {
+        let (x, y) = match part {
+            Some(p) => (&s1[key][p], &s3[key][p]),
+            None => (&s1[key], &s3[key]),
+        };
+        let (x, y) = (x.as_f64().unwrap(), y.as_f64().unwrap());
+        assert!(
+            (x - y).abs() <= 1e-12 * x.abs().max(y.abs()),
+            "summary.json {key} {part:?}: {x} against {y}"
+        );
+    };
+    close("kinetic_energy", None);
+    close("max_speed", None);
+    for part in ["dissipated", "wall_work", "kinetic", "elastic"] {
+        close("energy", Some(part));
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn sigterm_to_mpirun_ends_every_rank_with_the_outputs_written() {
+    let dir = scratch("sigterm");
+    let scene = settling_box(&dir, 60.0);
+    let out = dir.join("out");
+    let mut child = mpirun(2, &["run", scene.to_str().unwrap(), "--quiet", "--out"])
+        .arg(&out)
+        .spawn()
+        .unwrap();
+    // Until the run has written a few rows of its minute.
+    let started = Instant::now();
+    let rows = || std::fs::read_to_string(out.join("series.csv")).map_or(0, |t| t.lines().count());
+    while rows() < 5 {
+        assert!(
+            started.elapsed() < Duration::from_secs(60),
+            "no rows written"
+        );
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    let term = Command::new("kill")
+        .args(["-TERM", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(term.success());
+    let waited = Instant::now();
+    loop {
+        if child.try_wait().unwrap().is_some() {
+            break;
+        }
+        assert!(
+            waited.elapsed() < Duration::from_secs(30),
+            "the ranks did not end"
+        );
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    let s = summary(&out);
+    assert_eq!(s["ended_by"], "interrupted");
+    let t = s["time"].as_f64().unwrap();
+    assert!(t > 0.0 && t < 60.0, "ended at {t}");
+    // The last row is at the end, as an uninterrupted run's last row is.
+    let last = std::fs::read_to_string(out.join("series.csv")).unwrap();
+    let last_t: f64 = last
+        .lines()
+        .last()
+        .and_then(|l| l.split(',').next())
+        .and_then(|x| x.parse().ok())
+        .unwrap();
+    assert!(
+        (last_t - t).abs() <= 1e-9 * t,
+        "last row at {last_t}, end at {t}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The settling box poured for 0.1 s with a checkpoint every 35 ms, on two ranks:
+/// the newest checkpoint (at 70 ms, the whole run's state gathered on rank 0)
+/// resumes on three ranks and in one process, and each resumed run ends with the
+/// frames and series of an uninterrupted one-process run, byte for byte.
+#[test]
+fn checkpoints_of_two_ranks_resume_on_three_ranks_and_in_one_process() {
+    let dir = scratch("resume");
+    let scene = settling_box(&dir, 0.1);
+    let with_checkpoints = std::fs::read_to_string(&scene).unwrap().replace(
+        "csv_interval = 0.002",
+        "csv_interval = 0.002\ncheckpoint_interval = 0.035",
+    );
+    std::fs::write(&scene, with_checkpoints).unwrap();
+    let (one, two) = run_both(&scene, &dir, 2);
+    assert!(two.join("checkpoint.talus").exists());
+    let copy = dir.join("copy");
+    let status = Command::new("cp")
+        .arg("-r")
+        .args([&two, &copy])
+        .status()
+        .unwrap();
+    assert!(status.success());
+
+    let resume = |dir: &Path| {
+        vec![
+            "run".to_string(),
+            "--resume".into(),
+            dir.display().to_string(),
+            "--quiet".into(),
+            "--threads".into(),
+            "1".into(),
+        ]
+    };
+    let args = resume(&two);
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    let out = mpirun(3, &args).output().unwrap();
+    assert!(out.status.success(), "{}", text(&out));
+    let said = String::from_utf8_lossy(&out.stdout);
+    assert!(said.contains("finished at t = 1.000000e-1 s"), "{said}");
+    let out = Command::new(env!("CARGO_BIN_EXE_talus"))
+        .args(resume(&copy))
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", text(&out));
+    for resumed in [&two, &copy] {
+        assert_same_bytes(&one, resumed, 6, &["particles.pvd", "series.csv"]);
+        assert_eq!(summary(resumed)["steps"], summary(&one)["steps"]);
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A coupled fluid is refused on ranks, with the scene named.
+#[test]
+fn talus_run_on_ranks_refuses_what_it_cannot_do_yet() {
+    let dir = scratch("refuse");
+    std::fs::create_dir_all(&dir).unwrap();
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/scenes/fluid_column.toml");
+    let out = mpirun(2, &["run", scene.to_str().unwrap(), "--quiet", "--out"])
+        .arg(dir.join("out"))
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let said = text(&out);
+    assert!(
+        said.contains("fluid_column.toml: a coupled fluid ([fluid]) does not run on MPI ranks yet"),
+        "{said}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A bed of spheres (d = 5 mm) in a tube of 2 cm, fed at 400 per second from a box
+/// riding 2–5 cm above the bed height (measured every 5 ms), the spheres more than
+/// 2 cm below it frozen: on two ranks, rank 0 measures the bed from the top layers
+/// of both, every rank moves the box and freezes its own buried spheres, and the
+/// outputs, the packing analysis included, are one process's.
+#[test]
+fn a_bed_fed_from_above_and_frozen_packs_alike_on_two_ranks() {
+    let dir = scratch("bed");
+    std::fs::create_dir_all(&dir).unwrap();
+    let scene = dir.join("bed.toml");
+    std::fs::write(&scene, BED).unwrap();
+    let (one, two) = run_both(&scene, &dir, 2);
+    // 0.6 s at 0.1 s a frame: seven frames.
+    let files = [
+        "series.csv",
+        "packing.json",
+        "poses.csv",
+        "packing_axial.csv",
+    ];
+    assert_same_bytes(&one, &two, 7, &files);
+    let s = summary(&two);
+    assert_eq!(s["particles"], 240, "0.6 s at 400 per second");
+    assert!(s["frozen"].as_u64().unwrap() > 100, "{}", s["frozen"]);
+    assert_eq!(s["frozen"], summary(&one)["frozen"]);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+const BED: &str = r#"
+[simulation]
+dt = "auto"
+end_time = 0.6
+gravity = [0.0, 0.0, -9.81]
+seed = 4
+
+[output]
+frame_interval = 0.1
+csv_interval = 0.005
+
+[materials.glass]
+density = 2500.0
+young = 1e6
+poisson = 0.25
+restitution = 0.3
+friction = 0.3
+
+[shapes.ball]
+kind = "sphere"
+radius = 0.0025
+
+[[wall]]
+name = "tube"
+material = "glass"
+geometry = { kind = "cylinder", base = [0.0, 0.0, 0.0], axis = [0.0, 0.0, 1.0], length = 0.3, radius = 0.01, sides = 64, bottom = true }
+
+[[inlet]]
+shape = "ball"
+material = "glass"
+min = [-0.0065, -0.0065, 0.02]
+max = [0.0065, 0.0065, 0.05]
+rate = 400.0
+count = 2000
+bed_height = 0.15
+above_bed = true
+
+[bed]
+base = [0.0, 0.0, 0.0]
+radius = 0.01
+exclude = 0.005
+freeze = { depth = 0.02, max_speed = 0.01 }
+"#;
