@@ -12,6 +12,7 @@ mod expected;
 mod fmu;
 mod launch;
 mod run;
+mod run_outputs;
 #[cfg(feature = "zenoh")]
 mod serve;
 
