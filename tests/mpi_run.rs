@@ -237,10 +237,11 @@ fn sigterm_to_mpirun_ends_every_rank_with_the_outputs_written() {
 
 /// The settling box poured for 0.1 s with a checkpoint every 35 ms, on two ranks:
 /// the newest checkpoint (at 70 ms, the whole run's state gathered on rank 0)
-/// resumes on three ranks and in one process, and each resumed run ends with the
-/// frames and series of an uninterrupted one-process run, byte for byte.
+/// resumes on three ranks and in one process, one process's resumes on two ranks,
+/// and each resumed run ends with the frames and series of an uninterrupted
+/// one-process run, byte for byte.
 #[test]
-fn checkpoints_of_two_ranks_resume_on_three_ranks_and_in_one_process() {
+fn checkpoints_resume_on_any_number_of_ranks() {
     let dir = scratch("resume");
     let scene = settling_box(&dir, 0.1);
     let with_checkpoints = std::fs::read_to_string(&scene).unwrap().replace(
@@ -250,13 +251,13 @@ fn checkpoints_of_two_ranks_resume_on_three_ranks_and_in_one_process() {
     std::fs::write(&scene, with_checkpoints).unwrap();
     let (one, two) = run_both(&scene, &dir, 2);
     assert!(two.join("checkpoint.talus").exists());
-    let copy = dir.join("copy");
-    let status = Command::new("cp")
-        .arg("-r")
-        .args([&two, &copy])
-        .status()
-        .unwrap();
-    assert!(status.success());
+    let copy = |from: &Path, name: &str| {
+        let to = dir.join(name);
+        let status = Command::new("cp").arg("-r").arg(from).arg(&to).status();
+        assert!(status.unwrap().success());
+        to
+    };
+    let (two_in_one, one_on_two) = (copy(&two, "two_in_one"), copy(&one, "one_on_two"));
 
     let resume = |dir: &Path| {
         vec![
@@ -275,11 +276,15 @@ fn checkpoints_of_two_ranks_resume_on_three_ranks_and_in_one_process() {
     let said = String::from_utf8_lossy(&out.stdout);
     assert!(said.contains("finished at t = 1.000000e-1 s"), "{said}");
     let out = Command::new(env!("CARGO_BIN_EXE_talus"))
-        .args(resume(&copy))
+        .args(resume(&two_in_one))
         .output()
         .unwrap();
     assert!(out.status.success(), "{}", text(&out));
-    for resumed in [&two, &copy] {
+    let args = resume(&one_on_two);
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    let out = mpirun(2, &args).output().unwrap();
+    assert!(out.status.success(), "{}", text(&out));
+    for resumed in [&two, &two_in_one, &one_on_two] {
         assert_same_bytes(&one, resumed, 6, &["particles.pvd", "series.csv"]);
         assert_eq!(summary(resumed)["steps"], summary(&one)["steps"]);
     }
