@@ -18,7 +18,7 @@ use serde::{Deserialize, Serialize};
 use super::field::VelocityField;
 use super::surface::{SurfaceFit, fit_surface};
 use crate::Real;
-use crate::world::World;
+use crate::world::{MassMoments, World};
 
 /// A drum resolved against the world: which walls turn together, the axis and the
 /// part of the cross-section that is analysed. Axis and centre are kept in the first
@@ -100,13 +100,14 @@ impl Drum {
     /// Minus the gravitational moment of the bed about the axis: what the drive
     /// torque balances in steady motion.
     pub fn gravity_moment(&self, world: &World) -> Real {
+        self.gravity_moment_of(world, &world.mass_moments())
+    }
+
+    /// [`Drum::gravity_moment`] of a bed of mass moments `bed` (the whole run's,
+    /// on ranks): `Σ (x − c) × m g = (Σ m x − M c) × g`.
+    pub fn gravity_moment_of(&self, world: &World, bed: &MassMoments) -> Real {
         let (axis, centre) = self.frame(world);
-        let p = &world.particles;
-        let mut moment = Vector3::zeros();
-        for i in 0..p.len() {
-            let m = world.body_types[p.body_type[i] as usize].mass;
-            moment += (p.position[i] - centre).cross(&(world.gravity * m));
-        }
+        let moment = (bed.first - centre.coords * bed.mass).cross(&world.gravity);
         -moment.dot(&axis)
     }
 
@@ -301,10 +302,17 @@ impl DrumMonitor {
         &self.drum
     }
 
-    /// Accounts for a step of length `dt` that ended at the world's time.
-    pub fn record(&mut self, world: &World, dt: Real) {
+    /// Whether the step of length `dt` that ended at `t` takes a sample of the bed
+    /// (of the whole bed: on ranks, the world gathered).
+    pub fn samples_at(&self, t: Real, dt: Real) -> bool {
+        t >= self.next_sample - 1e-9 * dt
+    }
+
+    /// Accounts for a step of length `dt` that ended at the world's time, the bed's
+    /// mass moments being `bed` (see [`Drum::gravity_moment_of`]).
+    pub fn record(&mut self, world: &World, bed: &MassMoments, dt: Real) {
         let (drive, walls, power) = self.drum.torques(world);
-        let moment = self.drum.gravity_moment(world);
+        let moment = self.drum.gravity_moment_of(world, bed);
         let speed = self.drum.angular_speed(world);
         self.row.add(dt, drive, &walls, power, moment);
         self.revolution.add(dt, drive, &walls, power, moment);
@@ -319,7 +327,7 @@ impl DrumMonitor {
             self.window.add(dt, drive, &walls, power, moment);
             self.window_speed += speed.abs() * dt;
         }
-        if world.time >= self.next_sample - 1e-9 * dt {
+        if self.samples_at(world.time, dt) {
             self.sample(world, in_window);
             while self.next_sample <= world.time + 1e-9 * dt {
                 self.next_sample += self.drum.sample_interval;

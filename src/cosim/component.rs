@@ -445,7 +445,13 @@ impl Component {
                 }
                 last = now;
                 match &mut output {
-                    Some(out) => match out.record(sim.world(), sub, sim.stats().contacts, false) {
+                    Some(out) => match out.record(
+                        sim.world(),
+                        || sim.mass_moments(),
+                        sub,
+                        sim.stats().contacts,
+                        false,
+                    ) {
                         Ok(()) => ControlFlow::Continue(()),
                         Err(e) => ControlFlow::Break(e),
                     },
@@ -500,7 +506,13 @@ impl Component {
             "initialisation, step",
         )?;
         if let (Some(out), Some(sim)) = (&mut self.output, &self.sim) {
-            out.record(sim.world(), 0.0, sim.stats().contacts, true)?;
+            out.record(
+                sim.world(),
+                || sim.mass_moments(),
+                0.0,
+                sim.stats().contacts,
+                true,
+            )?;
             out.finish(sim.world())?;
         }
         self.output = None;

@@ -26,7 +26,7 @@ use plotters::style::RGBColor;
 use super::plot::{Cell, HeatMap, LineChart, Series};
 use crate::Real;
 use crate::analysis::{Drum, DrumMonitor, DrumRow, DrumSummary};
-use crate::world::World;
+use crate::world::{MassMoments, World};
 
 /// Writes a drum's files as the run goes.
 pub struct DrumOutput {
@@ -71,9 +71,9 @@ impl DrumOutput {
         &self.monitor
     }
 
-    /// Accounts for a step of length `dt`.
-    pub fn record(&mut self, world: &World, dt: Real) {
-        self.monitor.record(world, dt);
+    /// Accounts for a step of length `dt`, the bed's mass moments being `bed`.
+    pub fn record(&mut self, world: &World, bed: &MassMoments, dt: Real) {
+        self.monitor.record(world, bed, dt);
     }
 
     /// Writes a row of `drum.csv` (means since the previous row) and returns it.

@@ -37,7 +37,7 @@ use serde::Serialize;
 use crate::Real;
 use crate::analysis::{Drum, DrumSummary};
 use crate::engine::{Stage, StageTimes};
-use crate::world::World;
+use crate::world::{MassMoments, World};
 pub use clock::{Due, OutputClock};
 use drum::DrumOutput;
 pub use resume::OutputCursor;
@@ -257,16 +257,19 @@ impl RunOutput {
     }
 
     /// Called after every step of length `dt`: accumulates wall impulses and writes
-    /// the rows and frames that are due (all of them when `force` is set).
+    /// the rows and frames that are due (all of them when `force` is set). A drum
+    /// asks `bed` for the bed's mass moments (the whole run's, on ranks, where
+    /// `world` is the whole world only at rows, frames and the drum's samples).
     pub fn record(
         &mut self,
         world: &World,
+        bed: impl FnOnce() -> MassMoments,
         dt: Real,
         contacts: usize,
         force: bool,
     ) -> io::Result<()> {
         if let Some(d) = &mut self.drum {
-            d.record(world, dt);
+            d.record(world, &bed(), dt);
         }
         for (k, w) in world.walls.iter().enumerate() {
             self.impulses[k][0] += w.force * dt;
@@ -285,6 +288,14 @@ impl RunOutput {
         }
         self.clock.advance(due, t, dt);
         Ok(())
+    }
+
+    /// Whether the drum samples the bed after the step of length `dt` that ended
+    /// at `t` (it needs the whole world then).
+    pub fn drum_samples_at(&self, t: Real, dt: Real) -> bool {
+        self.drum
+            .as_ref()
+            .is_some_and(|d| d.monitor().samples_at(t, dt))
     }
 
     /// When rows and frames are due.

@@ -41,7 +41,9 @@ impl EnergyBalance {
         EnergyBalance {
             error: sim.energy().error(held.total()),
             ledger: *sim.energy(),
-            scale: held.kinetic + held.elastic + figures.mass * gravity * extent(sim, &figures),
+            scale: held.kinetic
+                + held.elastic
+                + figures.moments.mass * gravity * extent(sim, &figures),
         }
     }
 

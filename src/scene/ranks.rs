@@ -29,7 +29,7 @@ use crate::engine::decomposition::Decomposition;
 use crate::engine::exchange::Exchange;
 use crate::engine::rank::{ParticleRecord, RankStepper, Share, all_gather, gather_to_first};
 use crate::engine::{ContactHistory, StepStats};
-use crate::world::World;
+use crate::world::{MassMoments, World};
 
 /// The ranks bisect the space again at a list renewal where the most loaded rank's
 /// cost exceeds the mean by this factor: a fifth more work on one rank costs a
@@ -44,8 +44,8 @@ pub struct RunFigures {
     pub particles: usize,
     /// Of them, frozen.
     pub frozen: usize,
-    /// Their mass, kg.
-    pub mass: Real,
+    /// Their mass and its first moment.
+    pub moments: MassMoments,
     /// Kinetic energy, J.
     pub kinetic: Real,
     /// Potential energy in gravity (zero at the origin), J.
@@ -79,9 +79,7 @@ impl RunFigures {
         RunFigures {
             particles: n,
             frozen: p.frozen_count(),
-            mass: (0..n)
-                .map(|i| world.body_types[p.body_type[i] as usize].mass)
-                .sum(),
+            moments: world.mass_moments(),
             kinetic: held.kinetic,
             potential: held.potential,
             max_speed: world.max_speed(),
@@ -229,7 +227,7 @@ impl Simulation {
 /// minima, and six sums per wall.
 struct Shares(Vec<Real>);
 
-const SUMS: usize = 15;
+const SUMS: usize = 18;
 const MAXIMA: usize = 4;
 const MINIMA: usize = 4;
 
@@ -246,7 +244,10 @@ impl Shares {
             stats.fluid_work,
             f.particles as Real,
             f.frozen as Real,
-            f.mass,
+            f.moments.mass,
+            f.moments.first.x,
+            f.moments.first.y,
+            f.moments.first.z,
             f.kinetic,
             f.potential,
             inserted.kinetic,
@@ -296,6 +297,9 @@ impl Shares {
             particles,
             frozen,
             mass,
+            mx,
+            my,
+            mz,
             kinetic,
             potential,
             inserted_kinetic,
@@ -318,7 +322,10 @@ impl Shares {
         let figures = RunFigures {
             particles: count(particles),
             frozen: count(frozen),
-            mass,
+            moments: MassMoments {
+                mass,
+                first: Vector3::new(mx, my, mz),
+            },
             kinetic,
             potential,
             max_speed,

@@ -12,7 +12,7 @@ use super::spec::{FreezeSpec, SettleSpec, UpdateInterval};
 use crate::Real;
 use crate::analysis::packing::{Bed, bed_height_of};
 use crate::engine::{Backend, CpuBackend, StageTimes, StepParams, StepStats};
-use crate::world::{Inlet, Wall, World};
+use crate::world::{Inlet, MassMoments, Wall, World};
 
 /// A scene being simulated: the host's world, the backend that steps it, and what
 /// the host does between steps (inlets, the bed's measurement and freezing, the
@@ -417,6 +417,14 @@ impl Simulation {
         match &self.whole {
             Some(w) => w.figures.max_speed,
             None => self.world.max_speed(),
+        }
+    }
+
+    /// The particles' mass and its first moment.
+    pub fn mass_moments(&self) -> MassMoments {
+        match &self.whole {
+            Some(w) => w.figures.moments,
+            None => self.world.mass_moments(),
         }
     }
 

@@ -15,6 +15,16 @@ pub use fluid::{DragModel, FluidField, LocalFluid, MomentumExchange, ParticleFlu
 pub use inlet::{Inlet, Obstacle, PLACEMENT_ATTEMPTS, PlacedParticle, is_free, random_orientation};
 pub use motion::{DriveInput, MotionKey, WallMotion, WallVelocity, advance_pose};
 pub use particles::Particles;
+
+/// The mass of a set of particles and its first moment `Σ m x`: the moment of
+/// their weight about any point (a sum, so the shares of ranks add up).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct MassMoments {
+    /// Σ m, kg.
+    pub mass: Real,
+    /// Σ m x, kg m.
+    pub first: Vector3<Real>,
+}
 pub use walls::{FacetGrid, Wall};
 
 use crate::Real;
@@ -103,6 +113,18 @@ impl World {
                 wall.angular_velocity = w;
             }
         }
+    }
+
+    /// The mass of the owned particles and its first moment.
+    pub fn mass_moments(&self) -> MassMoments {
+        let p = &self.particles;
+        let mut m = MassMoments::default();
+        for i in 0..p.owned() {
+            let mass = self.body_types[p.body_type[i] as usize].mass;
+            m.mass += mass;
+            m.first += p.position[i].coords * mass;
+        }
+        m
     }
 
     /// Total kinetic energy (translation and rotation) of the owned particles.

@@ -78,7 +78,7 @@ pub fn run(path: Option<&Path>, options: RunOptions) -> Result<()> {
     }
     let mut launch = Launch::detect()?;
     if launch.is_rank() {
-        refuse_on_ranks(&scene)?;
+        talus::scene::ranks::check_on_ranks(&scene)?;
     }
     let (pool, threads) = worker_pool_of(options.threads, &scene, launch.local_ranks())?;
     let stop = Arc::new(AtomicBool::new(false));
@@ -104,18 +104,6 @@ pub fn run(path: Option<&Path>, options: RunOptions) -> Result<()> {
         run_loop(&scene, &dir, sim, start, checkpoints, &stop, quiet)
     })
     .map_err(|e| launch.fail(e))
-}
-
-/// What `talus run` does not do on MPI ranks yet.
-fn refuse_on_ranks(scene: &Scene) -> Result<()> {
-    let file = scene.file.display();
-    if scene.drum.is_some() {
-        bail!(
-            "{file}: the drum's analysis ([drum]) does not run on MPI ranks yet (it reads the \
-             whole bed every step); run in one process"
-        );
-    }
-    Ok(talus::scene::ranks::check_on_ranks(scene)?)
 }
 
 /// Steps between two checks of the energy balance (see
@@ -152,7 +140,11 @@ fn run_loop(
                 None
             };
             let clock = OutputClock::new(frame_interval, csv_interval, sim.time());
-            let mut out = Outputs { out, clock };
+            let mut out = Outputs {
+                out,
+                clock,
+                drum: scene.drum.is_some(),
+            };
             out.record(&sim, 0.0, true)?;
             (out, RunProgress::default())
         }
@@ -165,7 +157,11 @@ fn run_loop(
             } else {
                 None
             };
-            let out = Outputs { out, clock };
+            let out = Outputs {
+                out,
+                clock,
+                drum: scene.drum.is_some(),
+            };
             if !quiet {
                 eprintln!(
                     "resuming at t = {:.6e} s after {} steps from {}",
@@ -307,10 +303,12 @@ fn run_loop(
     if blown_up.is_none() {
         out.record(&sim, 0.0, true)?;
     }
-    // Every rank takes part in gathering the bed; rank 0 writes.
-    let bed_world = match &scene.bed {
-        Some(_) => sim.whole_world(),
-        None => None,
+    // The bed's files and the drum's summary read the whole world: every rank
+    // takes part in gathering it; rank 0 writes.
+    let whole = if scene.bed.is_some() || scene.drum.is_some() {
+        sim.whole_world()
+    } else {
+        None
     };
     let Some(mut out) = out.out else {
         return match blown_up {
@@ -318,7 +316,7 @@ fn run_loop(
             None => Ok(()),
         };
     };
-    let drum = out.finish(sim.world())?;
+    let drum = out.finish(whole.as_deref().unwrap_or(sim.world()))?;
     let elapsed = before.wall_clock_s + started.elapsed().as_secs_f64();
     let mut summary = summary(
         scene,
@@ -338,7 +336,7 @@ fn run_loop(
     if let Some(message) = blown_up {
         anyhow::bail!("{}: the run diverged: {message}", scene.file.display());
     }
-    if let (Some(bed), Some(world)) = (&scene.bed, &bed_world) {
+    if let (Some(bed), Some(world)) = (&scene.bed, &whole) {
         crate::analyze::write_bed_files(scene, bed, world, dir)?;
     }
     println!(

@@ -97,23 +97,36 @@ pub struct Outputs {
     /// The files, on rank 0.
     pub out: Option<RunOutput>,
     pub clock: OutputClock,
+    /// The scene has a drum, whose samples need the whole world.
+    pub drum: bool,
 }
 
 impl Outputs {
     /// [`RunOutput::record`] after a step of length `dt`, the whole world gathered
-    /// when a row or a frame is due.
+    /// when a row, a frame or a drum's sample is due.
     pub fn record(&mut self, sim: &Simulation, dt: Real, force: bool) -> Result<()> {
-        let due = self.clock.due(sim.time(), dt, force);
-        self.clock.advance(due, sim.time(), dt);
-        // Between rows and frames only the walls are read, whose forces are the
-        // whole run's on every rank.
-        let world = if due.any() {
+        let t = sim.time();
+        let due = self.clock.due(t, dt, force);
+        self.clock.advance(due, t, dt);
+        // Rank 0's drum keeps its own clock of samples; it tells the others.
+        let sample = self.drum
+            && sim.rank().is_some()
+            && sim.any_rank(self.out.as_ref().is_some_and(|o| o.drum_samples_at(t, dt)));
+        // Otherwise only the walls are read, whose forces are the whole run's on
+        // every rank, and the bed's mass moments, the whole run's too.
+        let world = if due.any() || sample {
             sim.whole_world()
         } else {
             Some(Cow::Borrowed(sim.world()))
         };
         if let (Some(out), Some(world)) = (&mut self.out, world) {
-            out.record(&world, dt, sim.stats().contacts, force)?;
+            out.record(
+                &world,
+                || sim.mass_moments(),
+                dt,
+                sim.stats().contacts,
+                force,
+            )?;
         }
         Ok(())
     }
