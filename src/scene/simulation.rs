@@ -3,8 +3,6 @@
 
 use std::ops::ControlFlow;
 
-use nalgebra::Vector3;
-
 use super::Scene;
 use super::energy_ledger::{EnergyLedger, HeldEnergy};
 use super::ranks::{RunFigures, WholeRun, bed_height_on_ranks};
@@ -327,13 +325,8 @@ impl Simulation {
         for inlet in &mut self.inlets {
             inlet.insert_due(&mut self.world, t, &mut self.next_id);
         }
-        // New particles feel gravity in their first half kick.
-        let p = &mut self.world.particles;
-        for i in first..p.len() {
-            p.force[i] = self.world.gravity * self.world.body_types[p.body_type[i] as usize].mass;
-            p.torque[i] = Vector3::zeros();
-        }
-        let added = first..p.len();
+        let added = first..self.world.particles.len();
+        self.world.weigh(added.clone());
         if added.is_empty() {
             return HeldEnergy::default();
         }

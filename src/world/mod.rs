@@ -8,6 +8,8 @@ mod motion;
 mod particles;
 mod walls;
 
+use std::ops::Range;
+
 use nalgebra::Vector3;
 
 pub use cell_shares::CellShares;
@@ -112,6 +114,16 @@ impl World {
                 wall.velocity = v;
                 wall.angular_velocity = w;
             }
+        }
+    }
+
+    /// Sets the force of particles `range` to their weight and their torque to
+    /// zero: what a particle just inserted feels in its first half kick.
+    pub fn weigh(&mut self, range: Range<usize>) {
+        let p = &mut self.particles;
+        for i in range {
+            p.force[i] = self.gravity * self.body_types[p.body_type[i] as usize].mass;
+            p.torque[i] = Vector3::zeros();
         }
     }
 

@@ -116,13 +116,15 @@ impl Launch {
         }
     }
 
-    /// The simulation of `scene` continuing from the whole run's `state`: the
-    /// whole of it, or this rank's share (once).
-    pub fn restored(&mut self, scene: &Scene, state: &SimState) -> Result<Simulation> {
+    /// The simulation of `scene` at its start, or continuing from the whole run's
+    /// `state`: the whole of it, or this rank's share (once).
+    pub fn simulation(&mut self, scene: &Scene, state: Option<&SimState>) -> Result<Simulation> {
         match self {
             Launch::OneProcess => {
                 let mut sim = Simulation::new(scene);
-                sim.restore(state)?;
+                if let Some(state) = state {
+                    sim.restore(state)?;
+                }
                 Ok(sim)
             }
             #[cfg(feature = "mpi")]
@@ -130,22 +132,10 @@ impl Launch {
                 let exchange = exchange
                     .take()
                     .ok_or_else(|| anyhow::anyhow!("one simulation per rank"))?;
-                Ok(Simulation::on_ranks_from(scene, exchange, state)?)
-            }
-        }
-    }
-
-    /// The simulation of `scene` at its start: the whole of it, or this rank's
-    /// share (once).
-    pub fn simulation(&mut self, scene: &Scene) -> Result<Simulation> {
-        match self {
-            Launch::OneProcess => Ok(Simulation::new(scene)),
-            #[cfg(feature = "mpi")]
-            Launch::Rank { exchange, .. } => {
-                let exchange = exchange
-                    .take()
-                    .ok_or_else(|| anyhow::anyhow!("one simulation per rank"))?;
-                Ok(Simulation::on_ranks(scene, exchange)?)
+                Ok(match state {
+                    Some(state) => Simulation::on_ranks_from(scene, exchange, state)?,
+                    None => Simulation::on_ranks(scene, exchange)?,
+                })
             }
         }
     }

@@ -96,9 +96,9 @@ pub fn run(path: Option<&Path>, options: RunOptions) -> Result<()> {
     let quiet = options.quiet || !launch.is_root();
     pool.install(|| {
         let sim = match &start {
-            None => launch.simulation(&scene)?,
+            None => launch.simulation(&scene, None)?,
             Some(c) => launch
-                .restored(&scene, &c.sim)
+                .simulation(&scene, Some(&c.sim))
                 .context("the checkpoint does not fit its scene")?,
         };
         run_loop(&scene, &dir, sim, start, checkpoints, &stop, quiet)

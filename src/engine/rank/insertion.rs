@@ -9,7 +9,7 @@
 //! with the same ids. It keeps those in its box; their ids make its lists stale,
 //! so the next step renews every rank's lists and the others get them as ghosts.
 
-use nalgebra::{Point3, Vector3};
+use nalgebra::Point3;
 
 use super::RankStepper;
 use crate::Real;
@@ -44,13 +44,11 @@ impl<E: Exchange> RankStepper<E> {
             let mine = placed
                 .iter()
                 .filter(|q| self.decomposition.owner(&q.position) == me);
+            let first = world.particles.owned();
             for particle in mine {
                 particle.push_into(&mut world.particles);
-                let i = world.particles.owned() - 1;
-                let mass = world.body_types[particle.body_type as usize].mass;
-                world.particles.force[i] = world.gravity * mass;
-                world.particles.torque[i] = Vector3::zeros();
             }
+            world.weigh(first..world.particles.owned());
         }
         placed_here_and_there
     }

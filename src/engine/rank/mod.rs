@@ -221,10 +221,7 @@ impl<E: Exchange> RankStepper<E> {
         let received = self.send_ghost_states(world);
         let p = &mut world.particles;
         for (k, record) in received.iter().flatten().enumerate() {
-            let i = p.owned() + k;
-            record.set_motion(p, i);
-            // Frozen between steps by the host's bed measurement.
-            p.frozen[i] = record.frozen;
+            record.set_state(p, p.owned() + k);
         }
     }
 
@@ -360,8 +357,7 @@ impl<E: Exchange> RankStepper<E> {
         for r in received.iter().flatten() {
             p.push_ghost(r.body_type, r.position, r.orientation, r.id);
             let i = p.len() - 1;
-            r.set_motion(p, i);
-            p.frozen[i] = r.frozen;
+            r.set_state(p, i);
         }
     }
 }

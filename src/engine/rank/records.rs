@@ -45,16 +45,17 @@ impl ParticleRecord {
     pub fn push_into(&self, p: &mut Particles) {
         p.push(self.body_type, self.position, self.orientation, self.id);
         let i = p.owned() - 1;
-        self.set_motion(p, i);
-        p.frozen[i] = self.frozen;
+        self.set_state(p, i);
     }
 
-    /// Writes the motion state into entry `i`.
-    pub(super) fn set_motion(&self, p: &mut Particles, i: usize) {
+    /// Writes the motion state and the frozen flag (a ghost's may change between
+    /// steps, by the host's bed measurement) into entry `i`.
+    pub(super) fn set_state(&self, p: &mut Particles, i: usize) {
         p.position[i] = self.position;
         p.orientation[i] = self.orientation;
         p.velocity[i] = self.velocity;
         p.angular_momentum[i] = self.angular_momentum;
+        p.frozen[i] = self.frozen;
     }
 }
 
