@@ -401,8 +401,9 @@ pub fn component_calls(data: &[u8]) {
     }
 }
 
-/// The zenoh service's protobuf messages, each queryable with any payload: an
-/// answer with a status, and a refused request leaves the component as it was.
+/// The zenoh service's protobuf messages, each queryable with any payload (the
+/// life-cycle calls of `<key>/call` too): an answer with a status, and a refused
+/// request leaves the component as it was.
 #[cfg(feature = "zenoh")]
 pub fn zenoh_messages(data: &[u8]) {
     use prost::Message;
@@ -419,7 +420,7 @@ pub fn zenoh_messages(data: &[u8]) {
         };
         let before = observe(service.component());
         let ok = pb::Status::Ok as i32;
-        let refused = match which % 6 {
+        let refused = match which % 7 {
             0 => {
                 // A valid step of more than 100 DEM steps is legitimate but slow.
                 if let Ok(request) = pb::StepRequest::decode(payload)
@@ -434,6 +435,18 @@ pub fn zenoh_messages(data: &[u8]) {
             2 => service.info(payload).status != ok,
             3 => service.state(payload).status != ok,
             5 => service.fluid(payload).status != ok,
+            6 => {
+                use pb::call_request::Call;
+                if let Ok(pb::CallRequest {
+                    call: Some(Call::DoStep(s)),
+                }) = pb::CallRequest::decode(payload)
+                    && s.step.is_finite()
+                    && s.step > 1e-2
+                {
+                    return;
+                }
+                service.call(payload).status != ok
+            }
             _ => service.forces().is_err(),
         };
         if refused {
@@ -515,6 +528,8 @@ pub fn seeds(target: &str) -> Vec<Vec<u8>> {
                 )),
             };
             let tagged = |tag: u8, body: Vec<u8>| [vec![tag], body].concat();
+            use pb::call_request::Call;
+            let call = |call| pb::CallRequest { call: Some(call) }.encode_to_vec();
             vec![
                 tagged(0, step.encode_to_vec()),
                 tagged(1, walls.encode_to_vec()),
@@ -522,6 +537,35 @@ pub fn seeds(target: &str) -> Vec<Vec<u8>> {
                 tagged(3, save.encode_to_vec()),
                 tagged(3, restore.encode_to_vec()),
                 vec![4],
+                tagged(
+                    6,
+                    call(Call::GetReal(pb::VarRefs {
+                        refs: vec![pb::VarRef {
+                            variable: 0,
+                            element: 0,
+                        }],
+                    })),
+                ),
+                tagged(
+                    6,
+                    call(Call::DoStep(pb::DoStep {
+                        time: 1e-3,
+                        step: 1e-3,
+                    })),
+                ),
+                tagged(6, call(Call::Terminate(true))),
+                tagged(6, call(Call::Reset(true))),
+                tagged(
+                    6,
+                    call(Call::SetReal(pb::SetReals {
+                        refs: vec![pb::VarRef {
+                            variable: 1,
+                            element: 0,
+                        }],
+                        values: vec![1e-5],
+                    })),
+                ),
+                tagged(6, call(Call::EnterInitialization(0.0))),
             ]
         }
         _ => Vec::new(),

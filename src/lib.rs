@@ -40,6 +40,7 @@ pub mod fluid;
 pub mod fmi;
 pub mod geometry;
 pub mod output;
+pub mod recording;
 pub mod scene;
 #[cfg(feature = "zenoh")]
 pub mod transport;

@@ -409,42 +409,13 @@ fn sim_bytes(c: &Component) -> Vec<u8> {
     w.into_bytes()
 }
 
-/// Beads falling onto a floor of a material so stiff that its contact stiffness
-/// overflows: the first contact makes the forces infinite.
-const OVERFLOWING: &str = r#"
-[simulation]
-dt = 1e-5
-end_time = 1.0
-gravity = [0.0, 0.0, -9.81]
-
-[materials.stiff]
-density = 2500.0
-young = 1.5e308
-poisson = 0.3
-restitution = 0.5
-
-[shapes.bead]
-kind = "sphere"
-radius = 0.004
-
-[[wall]]
-name = "floor"
-material = "stiff"
-geometry = { kind = "plane", centre = [0.0, 0.0, 0.0], normal = [0.0, 0.0, 1.0], size = 0.1 }
-
-[[particles]]
-kind = "lattice"
-shape = "bead"
-material = "stiff"
-min = [-0.02, -0.02, 0.01]
-max = [0.02, 0.02, 0.02]
-"#;
-
 #[test]
 fn a_step_that_diverges_is_rolled_back_to_the_bits_before_it() {
-    let dir = tempdir("diverging");
-    std::fs::write(dir.join("scene.toml"), OVERFLOWING).unwrap();
-    let mut c = Component::instantiate(&dir, "scene.toml").unwrap();
+    let mut c = Component::instantiate(
+        Path::new(env!("CARGO_MANIFEST_DIR")),
+        "tests/scenes/overflowing.toml",
+    )
+    .unwrap();
     c.enter_initialization_mode(0.0).unwrap();
     c.exit_initialization_mode().unwrap();
     c.do_step(0.0, 0.01).unwrap();

@@ -102,8 +102,8 @@ impl Component {
         match role {
             Role::Time => sim.map_or(0.0, |s| s.world().time),
             Role::TimeStep => self.params.dt,
-            Role::KineticEnergy => sim.map_or(0.0, |s| s.world().kinetic_energy()),
-            Role::MaxSpeed => sim.map_or(0.0, |s| s.world().max_speed()),
+            Role::KineticEnergy => sim.map_or(0.0, |s| s.kinetic_energy()),
+            Role::MaxSpeed => sim.map_or(0.0, |s| s.max_speed()),
             Role::WallVelocity(w) => match drive(w) {
                 WallDrive::Velocity { linear, .. } => linear[k],
                 _ => 0.0,
@@ -129,26 +129,33 @@ impl Component {
                 let wall = &self.world().walls[w];
                 (wall.pose * wall.vertices[k / 3])[k % 3]
             }
-            Role::WallFacetForces(w) => {
-                sim.map_or(0.0, |s| s.world().walls[w].facet_force[k / 3][k % 3])
-            }
+            Role::WallFacetForces(w) => match &self.gathered {
+                Some(g) => g.facet_forces[w][k / 3][k % 3],
+                None => sim.map_or(0.0, |s| s.world().walls[w].facet_force[k / 3][k % 3]),
+            },
             Role::DriveTorque => self.drum_means().0,
             Role::DrivePower => self.drum_means().1,
-            Role::AngleOfRepose => match (sim, &self.scene.drum) {
-                (Some(s), Some(d)) => d.surface(s.world()).map_or(0.0, |f| f.slope.atan().abs()),
+            Role::AngleOfRepose => match (sim, &self.scene.drum, &self.gathered) {
+                (Some(_), Some(_), Some(g)) => g.angle_of_repose,
+                (Some(s), Some(d), None) => {
+                    d.surface(s.world()).map_or(0.0, |f| f.slope.atan().abs())
+                }
                 _ => 0.0,
             },
             Role::BedHeight
             | Role::BedPorosity
             | Role::BedSpecificSurface
             | Role::BedPermeability => match (sim, &self.scene.bed) {
-                (Some(s), Some(bed)) => crate::analysis::packing::bed_figures(s.world(), bed)
-                    .map_or(0.0, |f| match role {
-                        Role::BedHeight => f.height,
-                        Role::BedPorosity => f.porosity,
-                        Role::BedSpecificSurface => f.specific_surface,
-                        _ => f.permeability,
-                    }),
+                (Some(s), Some(bed)) => match &self.gathered {
+                    Some(g) => g.bed.ok_or(()),
+                    None => crate::analysis::packing::bed_figures(s.world(), bed).map_err(|_| ()),
+                }
+                .map_or(0.0, |f| match role {
+                    Role::BedHeight => f.height,
+                    Role::BedPorosity => f.porosity,
+                    Role::BedSpecificSurface => f.specific_surface,
+                    _ => f.permeability,
+                }),
                 _ => 0.0,
             },
             Role::FluidVelocity | Role::PressureGradient => {
@@ -310,7 +317,7 @@ impl Component {
             let sim = self.sim.as_ref();
             *o = match v.role {
                 Role::Threads => self.params.threads as i64,
-                Role::Particles => sim.map_or(0, |s| s.world().particles.len() as i64),
+                Role::Particles => sim.map_or(0, |s| s.particle_count() as i64),
                 Role::Contacts => sim.map_or(0, |s| s.stats().contacts as i64),
                 _ => unreachable!("not an integer variable"),
             };

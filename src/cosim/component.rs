@@ -8,9 +8,12 @@ use nalgebra::{Point3, UnitQuaternion, Vector3};
 
 use super::CosimError;
 use super::pool::JoinedPool;
+use super::ranks::{Gathered, new_simulation};
 use super::variables::{Variable, variable_table};
 use crate::Real;
-use crate::output::RunOutput;
+use crate::engine::exchange::Ranks;
+use crate::output::{OutputClock, RunOutput};
+use crate::recording::Outputs;
 use crate::scene::energy_balance::EnergyBalance;
 use crate::scene::{Scene, SimState, Simulation};
 use crate::world::{DriveInput, ParticleFluid, WallMotion, World};
@@ -146,7 +149,11 @@ pub struct Component {
     pub(super) fluid_start: Option<FluidInputs>,
     pub(super) sim: Option<Simulation>,
     pub(super) pool: Option<JoinedPool>,
-    pub(super) output: Option<RunOutput>,
+    pub(super) output: Option<Outputs>,
+    /// On MPI ranks: the ranks (see [`super::ranks`]).
+    pub(super) ranks: Option<Box<dyn Ranks>>,
+    /// On ranks, rank 0's readings of the whole run after the last change.
+    pub(super) gathered: Option<Gathered>,
 }
 
 impl fmt::Debug for Component {
@@ -200,6 +207,8 @@ impl Component {
             sim: None,
             pool: None,
             output: None,
+            ranks: None,
+            gathered: None,
         })
     }
 
@@ -282,7 +291,9 @@ impl Component {
         }
         let pool =
             JoinedPool::new(self.params.threads).map_err(|e| CosimError::Threads(e.to_string()))?;
-        let mut sim = pool.install(|| Simulation::new(&self.scene));
+        let exchange = self.ranks.as_ref().map(|r| r.another());
+        let scene = &self.scene;
+        let mut sim = pool.install(move || new_simulation(scene, exchange, None))?;
         sim.set_time_step(self.params.dt);
         sim.set_time(start_time);
         if let Some(start) = &self.fluid_start {
@@ -309,13 +320,23 @@ impl Component {
         } else {
             let sim = self.sim.as_ref().expect("initialisation has a simulation");
             let out = &self.scene.spec.output;
-            Some(RunOutput::create(
-                &self.base_dir.join(&self.params.output_dir),
-                sim.world(),
-                out.frame_interval,
-                out.csv_interval,
-                self.scene.drum.as_ref(),
-            )?)
+            let root = self.rank().is_none_or(|(rank, _)| rank == 0);
+            let files = if root {
+                Some(RunOutput::create(
+                    &self.base_dir.join(&self.params.output_dir),
+                    sim.world(),
+                    out.frame_interval,
+                    out.csv_interval,
+                    self.scene.drum.as_ref(),
+                )?)
+            } else {
+                None
+            };
+            Some(Outputs {
+                out: files,
+                clock: OutputClock::new(out.frame_interval, out.csv_interval, sim.time()),
+                drum: self.scene.drum.is_some(),
+            })
         };
         self.check_orientations()?;
         let sim = self
@@ -346,6 +367,7 @@ impl Component {
         self.means = instantaneous_means(sim);
         self.output = output;
         self.mode = Mode::Step;
+        self.gather();
         Ok(())
     }
 
@@ -401,8 +423,9 @@ impl Component {
             .as_mut()
             .expect("a running component has a simulation");
         let pool = self.pool.as_ref().expect("a running component has a pool");
-        // Rollback through the saved state, not a copy of the whole simulation.
-        let before = sim.snapshot();
+        // Rollback through the saved state, not a copy of the whole simulation
+        // (on ranks: each rank's share, made whole only when it is needed).
+        let before = sim.share_snapshot();
         // The momentum source is the mean over this step (and the shares are new
         // with update_interval = "communication").
         sim.start_communication_step();
@@ -434,6 +457,10 @@ impl Component {
             }
         });
         let mut output = self.output.take();
+        // On ranks every rank takes every step: an output error (on rank 0 only) is
+        // kept for the end of the step instead of ending it there.
+        let on_ranks = self.ranks.is_some();
+        let mut failed = None;
         let result = pool.install(|| -> std::io::Result<()> {
             let mut last = instantaneous_means(sim);
             let advanced = sim.advance_to(end, |sim, sub| {
@@ -444,23 +471,18 @@ impl Component {
                     acc.power += (a.power + b.power) * (0.5 * sub);
                 }
                 last = now;
-                match &mut output {
-                    Some(out) => match out.record(
-                        sim.world(),
-                        || sim.mass_moments(),
-                        sub,
-                        sim.stats().contacts,
-                        false,
-                    ) {
-                        Ok(()) => ControlFlow::Continue(()),
-                        Err(e) => ControlFlow::Break(e),
-                    },
-                    None => ControlFlow::Continue(()),
+                match output.as_mut().map(|out| out.record(sim, sub, false)) {
+                    Some(Err(e)) if !on_ranks => ControlFlow::Break(e),
+                    Some(Err(e)) => {
+                        failed.get_or_insert(e);
+                        ControlFlow::Continue(())
+                    }
+                    _ => ControlFlow::Continue(()),
                 }
             });
-            match advanced {
-                ControlFlow::Continue(()) => Ok(()),
-                ControlFlow::Break(e) => Err(e),
+            match (advanced, failed) {
+                (ControlFlow::Break(e), _) | (_, Some(e)) => Err(e),
+                (ControlFlow::Continue(()), None) => Ok(()),
             }
         });
         sim.set_time(end);
@@ -471,19 +493,26 @@ impl Component {
             }
         });
         self.output = output;
-        if let Some(problem) = sim
+        let diverged = sim
             .first_non_finite()
             .map(|id| format!("particle {id} has a non-finite position, velocity or force"))
-            .or_else(|| balance.broken(sim))
-        {
-            sim.restore(&before)
+            .or_else(|| balance.broken(sim));
+        if let Some(problem) = diverged {
+            let before = self.whole_state(before);
+            self.install_state(&before)
                 .expect("a snapshot of this simulation restores");
+            self.gather();
             return Err(CosimError::Diverged(problem));
         }
+        self.gather();
         result?;
+        let sim = self
+            .sim
+            .as_ref()
+            .expect("a running component has a simulation");
         // A step too short for a sub-step (below 1e-9 of one) reports the forces of
         // the state it leaves, not a mean of nothing.
-        self.means = if sim.steps == before.steps {
+        self.means = if sim.steps == before.steps() {
             instantaneous_means(sim)
         } else {
             impulse
@@ -506,17 +535,24 @@ impl Component {
             "initialisation, step",
         )?;
         if let (Some(out), Some(sim)) = (&mut self.output, &self.sim) {
-            out.record(
-                sim.world(),
-                || sim.mass_moments(),
-                0.0,
-                sim.stats().contacts,
-                true,
-            )?;
-            out.finish(sim.world())?;
+            out.record(sim, 0.0, true)?;
+            out.finish(sim, &self.scene)?;
         }
         self.output = None;
         self.mode = Mode::Terminated;
+        Ok(())
+    }
+
+    /// Makes the parameters set so far the start values that [`Component::reset`]
+    /// returns to (instantiated mode only): a node keeps the output directory and
+    /// threads it was started with through the resets of a master.
+    pub fn keep_parameters_on_reset(&mut self) -> Result<(), CosimError> {
+        self.expect_mode(
+            "keeping the parameters",
+            &[Mode::Instantiated],
+            "instantiated",
+        )?;
+        self.start = self.params.clone();
         Ok(())
     }
 
@@ -525,6 +561,7 @@ impl Component {
         self.sim = None;
         self.pool = None;
         self.output = None;
+        self.gathered = None;
         if self.params.scene != self.start.scene {
             if let Ok(scene) = Scene::load(&self.base_dir.join(&self.start.scene)) {
                 self.fingerprint = fingerprint(&scene);

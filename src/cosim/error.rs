@@ -56,6 +56,9 @@ pub enum CosimError {
     /// Worker threads could not be started.
     #[error("cannot start worker threads: {0}")]
     Threads(String),
+    /// The scene cannot run on the ranks, or its state not be shared among them.
+    #[error("on MPI ranks: {0}")]
+    Ranks(String),
     /// Output files could not be written.
     #[error("output: {0}")]
     Output(#[from] std::io::Error),

@@ -28,6 +28,7 @@ mod access;
 mod component;
 mod error;
 pub mod pool;
+mod ranks;
 mod saved;
 pub mod variables;
 

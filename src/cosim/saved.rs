@@ -9,7 +9,8 @@ use crate::scene::state_bytes::STATE_MAGIC;
 use crate::scene::{SimState, StateError, StateReader, StateWriter};
 
 impl Component {
-    /// The state as it is now (initialisation, step or terminated mode).
+    /// The state as it is now (initialisation, step or terminated mode); on ranks
+    /// the whole run's, on every rank (collective).
     pub fn save_state(&self) -> Result<ComponentState, CosimError> {
         self.expect_mode(
             "saving the state",
@@ -18,13 +19,14 @@ impl Component {
         )?;
         Ok(ComponentState {
             fingerprint: self.fingerprint,
-            sim: self.sim.as_ref().expect("running").snapshot(),
+            sim: self.whole_state(self.sim.as_ref().expect("running").share_snapshot()),
             drives: self.drives.clone(),
             means: self.means.clone(),
         })
     }
 
-    /// Goes back to a saved state (of this scene).
+    /// Goes back to a saved state (of this scene; on ranks collective, saved on
+    /// any number of ranks or in one process).
     pub fn restore_state(&mut self, state: &ComponentState) -> Result<(), CosimError> {
         self.expect_mode(
             "restoring a state",
@@ -37,7 +39,8 @@ impl Component {
                 expected: self.fingerprint,
             }));
         }
-        self.sim.as_mut().expect("running").restore(&state.sim)?;
+        self.install_state(&state.sim)?;
+        self.gather();
         // The life cycle is the master's: a state saved in step mode and restored
         // during initialisation leaves the instance in initialisation.
         self.drives = state.drives.clone();

@@ -43,6 +43,58 @@ pub trait Exchange {
     }
 }
 
+impl<E: Exchange + ?Sized> Exchange for Box<E> {
+    fn rank(&self) -> usize {
+        (**self).rank()
+    }
+
+    fn size(&self) -> usize {
+        (**self).size()
+    }
+
+    fn all_to_all_words(&self, outgoing: Vec<Vec<u64>>) -> Vec<Vec<u64>> {
+        (**self).all_to_all_words(outgoing)
+    }
+}
+
+/// The ranks a long-lived host runs on (a component served by `mpirun talus
+/// serve`): its own exchange for what it tells the ranks, and another for each
+/// simulation it builds (at every initialisation and restore), since a
+/// simulation owns its exchange.
+pub trait Ranks: Exchange + Send + std::fmt::Debug {
+    /// An exchange among the same ranks, for a new simulation (collective: every
+    /// rank calls it at the same point).
+    fn another(&self) -> Box<dyn Ranks>;
+}
+
+/// Rank 0's `words` on every rank (collective; the others' `words` are ignored).
+pub fn broadcast_words(exchange: &dyn Exchange, words: Vec<u64>) -> Vec<u64> {
+    let mut outgoing = vec![Vec::new(); exchange.size()];
+    if exchange.rank() == 0 {
+        outgoing.fill(words);
+    }
+    exchange
+        .all_to_all_words(outgoing)
+        .into_iter()
+        .next()
+        .expect("at least one rank")
+}
+
+/// Rank 0's `bytes` on every rank (collective), as [`broadcast_words`].
+pub fn broadcast_bytes(exchange: &dyn Exchange, bytes: &[u8]) -> Vec<u8> {
+    let mut words = vec![bytes.len() as u64];
+    words.extend(bytes.chunks(8).map(|c| {
+        let mut w = [0u8; 8];
+        w[..c.len()].copy_from_slice(c);
+        u64::from_le_bytes(w)
+    }));
+    let words = broadcast_words(exchange, words);
+    let (len, body) = words.split_first().expect("a length word");
+    let mut bytes: Vec<u8> = body.iter().flat_map(|w| w.to_le_bytes()).collect();
+    bytes.truncate(*len as usize);
+    bytes
+}
+
 /// The ranks of a run as threads of one process: [`ThreadExchange::group`] makes one
 /// per rank, each moved to its own thread. Messages go through the same words as
 /// under MPI.
@@ -103,5 +155,13 @@ impl Exchange for ThreadExchange {
         // Nobody writes the next round's slots before everyone took this round's.
         self.barrier.wait();
         received
+    }
+}
+
+impl Ranks for ThreadExchange {
+    /// The same slots: the ranks' collectives are called in one order on all of
+    /// them, whichever exchange they go through, so one set of slots serves all.
+    fn another(&self) -> Box<dyn Ranks> {
+        Box::new(self.clone())
     }
 }

@@ -8,7 +8,7 @@ use mpi::environment::{Threading, Universe};
 use mpi::topology::SimpleCommunicator;
 use mpi::traits::{Communicator, CommunicatorCollectives};
 
-use super::exchange::Exchange;
+use super::exchange::{Exchange, Ranks};
 
 /// The ranks of a communicator (usually `universe.world()`; the MPI universe must
 /// outlive it). It may move to another thread: MPI was initialised with
@@ -109,5 +109,15 @@ impl Exchange for MpiExchange {
             .zip(&receive_at)
             .map(|(&n, &at)| received[at as usize..(at + n) as usize].to_vec())
             .collect()
+    }
+}
+
+impl Ranks for MpiExchange {
+    /// A duplicate of the communicator (`MPI_Comm_dup`, collective): messages of
+    /// the new exchange never meet those of this one.
+    fn another(&self) -> Box<dyn Ranks> {
+        Box::new(MpiExchange {
+            comm: self.comm.duplicate(),
+        })
     }
 }

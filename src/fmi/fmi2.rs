@@ -182,7 +182,7 @@ pub unsafe extern "C" fn fmi2Terminate(c: Component) -> Status {
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi2Reset(c: Component) -> Status {
     on_instance(c, "fmi2Reset", |inst| {
-        inst.component.reset();
+        inst.component.reset()?;
         inst.start_time = 0.0;
         Ok(OK)
     })
@@ -493,10 +493,7 @@ pub unsafe extern "C" fn fmi2GetRealStatus(c: Component, kind: c_int, value: *mu
         if kind != LAST_SUCCESSFUL_TIME {
             return Err(format!("status kind {kind} is not a real status"));
         }
-        let t = inst
-            .component
-            .simulation()
-            .map_or(inst.start_time, |s| s.world().time);
+        let t = inst.component.time().unwrap_or(inst.start_time);
         unsafe { put(value, t, "value") }?;
         Ok(OK)
     })

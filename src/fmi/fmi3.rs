@@ -233,7 +233,7 @@ pub unsafe extern "C" fn fmi3Terminate(instance: Instance3) -> Status {
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi3Reset(instance: Instance3) -> Status {
     on_instance(instance, "fmi3Reset", |inst| {
-        inst.component.reset();
+        inst.component.reset()?;
         Ok(OK)
     })
 }
@@ -475,10 +475,7 @@ pub unsafe extern "C" fn fmi3DoStep(
         let result = inst
             .component
             .do_step(current_communication_point, communication_step_size);
-        let t = inst
-            .component
-            .simulation()
-            .map_or(current_communication_point, |s| s.world().time);
+        let t = inst.component.time().unwrap_or(current_communication_point);
         for (p, what) in [
             (event_handling_needed, "eventHandlingNeeded"),
             (terminate_simulation, "terminateSimulation"),

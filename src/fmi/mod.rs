@@ -20,6 +20,10 @@ pub mod description;
 mod fmi2;
 mod fmi3;
 pub mod package;
+#[cfg(feature = "zenoh")]
+mod remote;
+pub mod remote_spec;
+mod slave;
 mod state;
 
 use std::ffi::{CString, c_char, c_int, c_void};
@@ -27,6 +31,7 @@ use std::path::PathBuf;
 
 use crate::cosim::{Component, VarRef, Variable};
 use crate::ffi::guard::catch;
+use slave::Slave;
 
 /// Name of the shared library inside an FMU (`binaries/<platform>/talus.so`).
 pub const MODEL_IDENTIFIER: &str = "talus";
@@ -126,7 +131,7 @@ pub(crate) enum LogSink {
 /// One FMU instance.
 pub(crate) struct Instance {
     pub name: CString,
-    pub component: Component,
+    pub component: Box<dyn Slave>,
     pub sink: LogSink,
     pub logging_on: bool,
     /// Strings handed out by GetString, alive until the next call that returns some.
@@ -183,8 +188,11 @@ impl Instance {
                 resources.display()
             ));
         }
-        let component =
-            Component::instantiate(&resources, SCENE_FILE).map_err(|e| e.to_string())?;
+        let component: Box<dyn Slave> = if resources.join(remote_spec::REMOTE_FILE).is_file() {
+            remote_slave(&resources)?
+        } else {
+            Box::new(Component::instantiate(&resources, SCENE_FILE).map_err(|e| e.to_string())?)
+        };
         let expected = guid(component.fingerprint());
         if guid_given != expected {
             return Err(format!(
@@ -233,6 +241,21 @@ impl Instance {
         self.strings = strings.iter().map(|s| c_string(s)).collect();
         self.strings.iter().map(|s| s.as_ptr()).collect()
     }
+}
+
+/// The instance of a proxy FMU (see [`remote_spec`]).
+#[cfg(feature = "zenoh")]
+fn remote_slave(resources: &std::path::Path) -> Result<Box<dyn Slave>, String> {
+    Ok(Box::new(remote::Remote::connect(resources)?))
+}
+
+#[cfg(not(feature = "zenoh"))]
+fn remote_slave(_: &std::path::Path) -> Result<Box<dyn Slave>, String> {
+    Err(format!(
+        "this FMU forwards its calls to a talus node ({}), but its library was built \
+         without the `zenoh` feature",
+        remote_spec::REMOTE_FILE
+    ))
 }
 
 /// Runs an entry point on an instance: null checked, panics caught (the component

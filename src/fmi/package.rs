@@ -4,13 +4,16 @@
 //! scene as the FMU will load it), the shared library as
 //! `binaries/linux64/talus.so` (FMI 2) or `binaries/x86_64-linux/talus.so` (FMI 3),
 //! and under `resources/` the scene as `scene.toml` with every file it names (wall
-//! meshes, particle meshes, pose files) at the same relative paths.
+//! meshes, particle meshes, pose files) at the same relative paths. A proxy FMU
+//! (`talus fmu --remote KEY`) holds `resources/remote.toml` besides: its instances
+//! forward every call to a `talus serve` node.
 
 use std::path::{Component as PathPart, Path, PathBuf};
 
 use thiserror::Error;
 
 use super::description::{self, FmiVersion};
+use super::remote_spec::{REMOTE_FILE, RemoteSpec};
 use super::{MODEL_IDENTIFIER, SCENE_FILE, guid};
 use crate::cosim::{Component, CosimError};
 use crate::geometry::ShapeSpec;
@@ -98,6 +101,30 @@ pub fn write_fmu(
     version: FmiVersion,
     out: &Path,
 ) -> Result<FmuSummary, PackageError> {
+    pack(scene_path, library, version, out, None)
+}
+
+/// Packs a proxy FMU: the scene at `scene_path` (for the variables and the guid)
+/// and `remote` as `resources/remote.toml`, so that its instances forward every
+/// call to the `talus serve` node `remote` names (the library must be built with
+/// the `zenoh` feature).
+pub fn write_remote_fmu(
+    scene_path: &Path,
+    library: &Path,
+    version: FmiVersion,
+    out: &Path,
+    remote: &RemoteSpec,
+) -> Result<FmuSummary, PackageError> {
+    pack(scene_path, library, version, out, Some(remote))
+}
+
+fn pack(
+    scene_path: &Path,
+    library: &Path,
+    version: FmiVersion,
+    out: &Path,
+    remote: Option<&RemoteSpec>,
+) -> Result<FmuSummary, PackageError> {
     let scene = Scene::load(scene_path)?;
     let scene_dir = scene_path.parent().unwrap_or(Path::new("."));
     let mut resources = vec![(
@@ -122,6 +149,11 @@ pub fn write_fmu(
         resources.push((file, bytes));
     }
 
+    // The component is loaded without it: a proxy's variables are the scene's.
+    let staged = resources.len();
+    if let Some(remote) = remote {
+        resources.push((PathBuf::from(REMOTE_FILE), remote.to_toml().into_bytes()));
+    }
     // Load the component exactly as the FMU will: from a resources directory.
     let staging = std::env::temp_dir().join(format!(
         "talus-fmu-{}-{}",
@@ -131,7 +163,7 @@ pub fn write_fmu(
             .map_or(0, |d| d.as_nanos())
     ));
     let result = (|| {
-        for (path, bytes) in &resources {
+        for (path, bytes) in &resources[..staged] {
             let target = staging.join(path);
             if let Some(dir) = target.parent() {
                 std::fs::create_dir_all(dir).map_err(io(dir))?;

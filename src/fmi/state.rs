@@ -1,10 +1,10 @@
-//! FMU states for both FMI versions: a state is a boxed [`ComponentState`]; its
-//! pointer goes to the master and comes back in Set, Free and Serialize.
+//! FMU states for both FMI versions: a state is a boxed [`FmuState`]; its pointer
+//! goes to the master and comes back in Set, Free and Serialize.
 
 use std::ffi::{c_int, c_void};
 
+use super::slave::FmuState;
 use super::{Instance, OK};
-use crate::cosim::ComponentState;
 use crate::ffi::guard::{put, slice, slice_mut};
 
 type Status = c_int;
@@ -14,13 +14,13 @@ pub(super) fn get_state(inst: &mut Instance, state: *mut *mut c_void) -> Result<
     if state.is_null() {
         return Err("FMUstate is a null pointer".into());
     }
-    let saved = inst.component.save_state().map_err(|e| e.to_string())?;
+    let saved = inst.component.save_state()?;
     // SAFETY: checked non-null; a non-null *state came from an earlier GetFMUstate.
     unsafe {
         if (*state).is_null() {
             *state = Box::into_raw(Box::new(saved)) as *mut c_void;
         } else {
-            *((*state) as *mut ComponentState) = saved;
+            *((*state) as *mut FmuState) = saved;
         }
     }
     Ok(OK)
@@ -32,10 +32,8 @@ pub(super) fn set_state(inst: &mut Instance, state: *mut c_void) -> Result<Statu
         return Err("FMUstate is a null pointer".into());
     }
     // SAFETY: a state pointer comes from GetFMUstate or DeSerializeFMUstate.
-    let state = unsafe { &*(state as *const ComponentState) };
-    inst.component
-        .restore_state(state)
-        .map_err(|e| e.to_string())?;
+    let state = unsafe { &*(state as *const FmuState) };
+    inst.component.restore_state(state)?;
     Ok(OK)
 }
 
@@ -45,7 +43,7 @@ pub(super) fn free_state(state: *mut *mut c_void) -> Result<Status, String> {
         // SAFETY: as for set_state; the pointer is cleared after the drop.
         unsafe {
             if !(*state).is_null() {
-                drop(Box::from_raw(*state as *mut ComponentState));
+                drop(Box::from_raw(*state as *mut FmuState));
                 *state = std::ptr::null_mut();
             }
         }
@@ -84,8 +82,8 @@ fn bytes_of(inst: &Instance, state: *mut c_void) -> Result<Vec<u8>, String> {
         return Err("FMUstate is a null pointer".into());
     }
     // SAFETY: as for set_state.
-    let state = unsafe { &*(state as *const ComponentState) };
-    Ok(inst.component.state_to_bytes(state))
+    let state = unsafe { &*(state as *const FmuState) };
+    inst.component.state_to_bytes(state)
 }
 
 /// A state from bytes, into a new state or over the one `*state` points to.
@@ -99,16 +97,13 @@ pub(super) fn deserialise(
     if state.is_null() {
         return Err("FMUstate is a null pointer".into());
     }
-    let restored = inst
-        .component
-        .state_from_bytes(data)
-        .map_err(|e| e.to_string())?;
+    let restored = inst.component.state_from_bytes(data)?;
     // SAFETY: checked non-null; a non-null *state came from an earlier call.
     unsafe {
         if (*state).is_null() {
             *state = Box::into_raw(Box::new(restored)) as *mut c_void;
         } else {
-            *((*state) as *mut ComponentState) = restored;
+            *((*state) as *mut FmuState) = restored;
         }
     }
     Ok(OK)

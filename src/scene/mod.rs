@@ -31,6 +31,7 @@ pub use build::MAX_THREADS;
 pub use error::{FieldError, FieldPath, FieldSegment, SceneError};
 pub use fluid_coupling::FluidError;
 pub use plan::Plan;
+pub use rank_states::ShareState;
 pub use simulation::{Simulation, StepReport};
 pub use spec::SceneSpec;
 pub use state::{FluidState, InletState, SimState, WallState};

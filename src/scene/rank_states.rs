@@ -25,44 +25,67 @@ use crate::world::Particles;
 /// the step that ended (the next half kick's).
 type SavedParticle = (ParticleRecord, (Vector3<Real>, Vector3<Real>));
 
+/// One rank's share of the whole run's state, taken without talking to the other
+/// ranks (a component takes one before every step, to go back to it if the step
+/// diverges); [`Simulation::gather_state`] makes the whole state of it. In one
+/// process it is the whole state.
+#[derive(Clone, Debug)]
+pub struct ShareState {
+    /// This rank's particles with their forces, the contact history this rank
+    /// counts, its share of the facet forces; the rest as every rank holds it,
+    /// with the whole run's figures.
+    state: SimState,
+}
+
+impl ShareState {
+    /// Steps taken when it was taken.
+    pub fn steps(&self) -> u64 {
+        self.state.steps
+    }
+}
+
 impl Simulation {
-    /// The whole run's state: in one process [`Simulation::snapshot`]; on ranks
-    /// (collective) gathered on rank 0, and `None` on the others.
-    pub fn whole_snapshot(&self) -> Option<SimState> {
-        let Some(share) = self.backend.share() else {
-            return Some(self.snapshot());
-        };
-        let p = &self.world.particles;
-        let particles: Vec<SavedParticle> = (0..p.owned())
-            .map(|i| (ParticleRecord::of(p, i), (p.force[i], p.torque[i])))
-            .collect();
+    /// This rank's share of the state (see [`ShareState`]; no collective).
+    pub fn share_snapshot(&self) -> ShareState {
+        let mut state = self.snapshot();
+        if self.backend.share().is_none() {
+            return ShareState { state };
+        }
+        state.stats = *self.stats();
         // A pair's history from the one rank that counts it (the other may hold a
         // stale copy); a patch's from its particle's owner.
-        let held = self.backend.contact_history();
+        let p = &self.world.particles;
         let counted = |a: u64, b: u64| match (p.index_of(a), p.index_of(b)) {
             (Some(i), Some(j)) => p.counts_pair(i, j),
             _ => false,
         };
-        let mine = ContactHistory {
-            pairs: held
-                .pairs
-                .into_iter()
-                .filter(|((a, b), _)| counted(*a, *b))
-                .collect(),
-            walls: held
-                .walls
-                .into_iter()
-                .filter(|(key, _)| p.index_of(key.0).is_some_and(|i| !p.is_ghost(i)))
-                .collect(),
+        state.history.pairs.retain(|((a, b), _)| counted(*a, *b));
+        state
+            .history
+            .walls
+            .retain(|(key, _)| p.index_of(key.0).is_some_and(|i| !p.is_ghost(i)));
+        ShareState { state }
+    }
+
+    /// The whole run's state of every rank's `share` (taken at the same step): in
+    /// one process the share itself; on ranks (collective) gathered on rank 0 (the
+    /// state one process saves: particles in id order with their forces, history
+    /// sorted by key), and `None` on the others.
+    pub fn gather_state(&self, share: ShareState) -> Option<SimState> {
+        let ShareState { mut state } = share;
+        let Some(ranks) = self.backend.share() else {
+            return Some(state);
         };
-        let particles = gather_to_first(share, &particles);
-        let histories = gather_to_first(share, &[mine]);
-        let facets = sum_facet_forces(share, &self.world);
-        if share.rank() != 0 {
+        let p = &state.particles;
+        let particles: Vec<SavedParticle> = (0..p.owned())
+            .map(|i| (ParticleRecord::of(p, i), (p.force[i], p.torque[i])))
+            .collect();
+        let particles = gather_to_first(ranks, &particles);
+        let histories = gather_to_first(ranks, &[std::mem::take(&mut state.history)]);
+        let facets = sum_facet_forces(ranks, state.walls.iter().map(|w| &w.facet_force));
+        if ranks.rank() != 0 {
             return None;
         }
-        let mut state = self.snapshot();
-        state.stats = *self.stats();
         state.particles = saved_particles(particles.into_iter().flatten().collect());
         let mut history = ContactHistory::default();
         for h in histories.into_iter().flatten() {
@@ -74,6 +97,12 @@ impl Simulation {
         state.history = history;
         spread_facet_forces(&facets, state.walls.iter_mut().map(|w| &mut w.facet_force));
         Some(state)
+    }
+
+    /// The whole run's state: in one process [`Simulation::snapshot`]; on ranks
+    /// (collective) gathered on rank 0, and `None` on the others.
+    pub fn whole_snapshot(&self) -> Option<SimState> {
+        self.gather_state(self.share_snapshot())
     }
 
     /// A run of `scene` on the ranks of `exchange` that continues from `state` (the

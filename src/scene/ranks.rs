@@ -189,13 +189,34 @@ impl Simulation {
         let records: Vec<ParticleRecord> =
             (0..p.owned()).map(|i| ParticleRecord::of(p, i)).collect();
         let records = gather_to_first(share, &records);
-        let total = sum_facet_forces(share, &self.world);
+        let total = sum_facet_forces(share, self.world.walls.iter().map(|w| &w.facet_force));
         if share.rank() != 0 {
             return None;
         }
         let mut whole = world_of(&self.world, records.into_iter().flatten().collect());
         spread_facet_forces(&total, whole.walls.iter_mut().map(|w| &mut w.facet_force));
         Some(Cow::Owned(whole))
+    }
+
+    /// Every wall's facet forces summed over the ranks: in one process the world's;
+    /// on ranks (collective) on rank 0, and `None` on the others.
+    pub fn whole_facet_forces(&self) -> Option<Vec<Vec<Vector3<Real>>>> {
+        let facets = self.world.walls.iter().map(|w| &w.facet_force);
+        let Some(share) = self.backend.share() else {
+            return Some(facets.cloned().collect());
+        };
+        let total = sum_facet_forces(share, facets);
+        if share.rank() != 0 {
+            return None;
+        }
+        let mut whole: Vec<_> = self
+            .world
+            .walls
+            .iter()
+            .map(|w| w.facet_force.clone())
+            .collect();
+        spread_facet_forces(&total, whole.iter_mut());
+        Some(whole)
     }
 
     /// On ranks (collective): folds every rank's share of the step, of the
@@ -404,14 +425,14 @@ pub(super) fn seeds_of(world: &World) -> Vec<Point3<Real>> {
         .collect()
 }
 
-/// Every wall's facet forces (all walls' facets in a row) summed over the ranks
-/// in rank order, on rank 0 (collective; empty on the others).
-pub(super) fn sum_facet_forces(share: &dyn Share, world: &World) -> Vec<Vector3<Real>> {
-    let facets: Vec<Vector3<Real>> = world
-        .walls
-        .iter()
-        .flat_map(|w| w.facet_force.iter().copied())
-        .collect();
+/// Every wall's facet forces (`walls`: each wall's, all walls' facets in a row)
+/// summed over the ranks in rank order, on rank 0 (collective; empty on the
+/// others).
+pub(super) fn sum_facet_forces<'a>(
+    share: &dyn Share,
+    walls: impl Iterator<Item = &'a Vec<Vector3<Real>>>,
+) -> Vec<Vector3<Real>> {
+    let facets: Vec<Vector3<Real>> = walls.flatten().copied().collect();
     let mut ranks = gather_to_first(share, &facets).into_iter();
     let first = ranks.next().unwrap_or_default();
     ranks.fold(first, |mut total, other| {

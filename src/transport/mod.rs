@@ -18,7 +18,9 @@ pub mod messages {
     #![allow(missing_docs, clippy::all)]
     include!(concat!(env!("OUT_DIR"), "/talus.v1.rs"));
 }
+mod call;
 mod node;
+mod ranks;
 mod service;
 
 pub use node::{Node, NodeConfig, TransportError};

@@ -97,7 +97,7 @@ impl Node {
         let publisher = Arc::new(publisher);
 
         let mut workers = Vec::new();
-        for endpoint in ["step", "walls", "info", "state", "fluid"] {
+        for endpoint in ["step", "walls", "info", "state", "fluid", "call"] {
             let queryable = session
                 .declare_queryable(format!("{key}/{endpoint}"))
                 .wait()
@@ -132,6 +132,7 @@ impl Node {
                             "walls" => service.walls(&payload).encode_to_vec(),
                             "info" => service.info(&payload).encode_to_vec(),
                             "fluid" => service.fluid(&payload).encode_to_vec(),
+                            "call" => service.call(&payload).encode_to_vec(),
                             _ => service.state(&payload).encode_to_vec(),
                         };
                         drop(service);

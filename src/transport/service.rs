@@ -7,14 +7,18 @@ use super::messages::{
     self as pb, InfoReply, StateReply, StepReply, WallForces, WallsReply, state_request,
     wall_motion,
 };
+use super::ranks::Call;
 use crate::Real;
 use crate::cosim::{Causality, Component, VarRef, VarType};
+use crate::engine::exchange::Ranks;
 
 /// A component behind the message interface.
 #[derive(Debug)]
 pub struct Service {
-    component: Component,
+    pub(super) component: Component,
     sequence: u64,
+    /// On MPI ranks: the ranks rank 0 hands its requests to (see [`super::ranks`]).
+    pub(super) ranks: Option<Box<dyn Ranks>>,
 }
 
 fn vec3(v: &[Real]) -> pb::Vec3 {
@@ -35,6 +39,7 @@ impl Service {
         Service {
             component,
             sequence: 0,
+            ranks: None,
         }
     }
 
@@ -55,12 +60,13 @@ impl Service {
             .map_err(|e| e.to_string())
     }
 
-    fn time(&self) -> Real {
+    pub(super) fn time(&self) -> Real {
         self.component.simulation().map_or(0.0, |s| s.world().time)
     }
 
     /// `<key>/step`: sets the wall inputs and steps; on any error nothing changes.
     pub fn step(&mut self, payload: &[u8]) -> StepReply {
+        self.tell_ranks(Call::Step, payload);
         match self.try_step(payload) {
             Ok(reply) => reply,
             Err(error) => StepReply {
@@ -181,10 +187,10 @@ impl Service {
             time: sim.world().time,
             walls,
             globals: Some(pb::Globals {
-                particles: sim.world().particles.len() as u64,
+                particles: sim.particle_count() as u64,
                 contacts: sim.stats().contacts as u64,
-                kinetic_energy: sim.world().kinetic_energy(),
-                max_speed: sim.world().max_speed(),
+                kinetic_energy: sim.kinetic_energy(),
+                max_speed: sim.max_speed(),
             }),
             sequence: self.sequence,
         })
@@ -320,6 +326,7 @@ impl Service {
             walls,
             variables,
             talus_version: env!("CARGO_PKG_VERSION").into(),
+            fingerprint: c.fingerprint(),
         }
     }
 
@@ -364,6 +371,7 @@ impl Service {
 
     /// `<key>/state`: save (the bytes come back) or restore.
     pub fn state(&mut self, payload: &[u8]) -> StateReply {
+        self.tell_ranks(Call::State, payload);
         let result = (|| {
             let request = pb::StateRequest::decode(payload)
                 .map_err(|e| format!("malformed StateRequest: {e}"))?;

@@ -36,3 +36,11 @@ def fmus(tmp_path_factory):
                            check=True, capture_output=True)
             paths[(name, version)] = path
     return paths
+
+
+@pytest.fixture(scope="session")
+def proto_dir(tmp_path_factory):
+    """The Python classes of the zenoh messages, written by `talus proto`."""
+    out = tmp_path_factory.mktemp("proto")
+    subprocess.run([str(TALUS), "proto", "--python-out", str(out)], check=True, capture_output=True)
+    return out

@@ -4,7 +4,8 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
 use talus::fmi::description::FmiVersion;
-use talus::fmi::package::write_fmu;
+use talus::fmi::package::{write_fmu, write_remote_fmu};
+use talus::fmi::remote_spec::RemoteSpec;
 
 /// The shared library next to the running program (`target/<profile>/libtalus.so`).
 fn default_library() -> Result<PathBuf> {
@@ -20,7 +21,13 @@ fn default_library() -> Result<PathBuf> {
     Ok(lib)
 }
 
-pub fn fmu(scene: &Path, output: &Path, fmi: u8, library: Option<PathBuf>) -> Result<()> {
+pub fn fmu(
+    scene: &Path,
+    output: &Path,
+    fmi: u8,
+    library: Option<PathBuf>,
+    remote: Option<RemoteSpec>,
+) -> Result<()> {
     let library = match library {
         Some(l) => l,
         None => default_library()?,
@@ -30,8 +37,11 @@ pub fn fmu(scene: &Path, output: &Path, fmi: u8, library: Option<PathBuf>) -> Re
     } else {
         FmiVersion::Two
     };
-    let summary = write_fmu(scene, &library, version, output)
-        .with_context(|| format!("cannot pack {}", scene.display()))?;
+    let summary = match &remote {
+        None => write_fmu(scene, &library, version, output),
+        Some(remote) => write_remote_fmu(scene, &library, version, output, remote),
+    }
+    .with_context(|| format!("cannot pack {}", scene.display()))?;
     println!(
         "{}: FMI {fmi}.0 co-simulation FMU, {} variables, guid {}, {} resource file(s), {:.1} MB",
         output.display(),
@@ -40,6 +50,21 @@ pub fn fmu(scene: &Path, output: &Path, fmi: u8, library: Option<PathBuf>) -> Re
         summary.resources.len(),
         summary.bytes as f64 / 1e6
     );
+    if let Some(remote) = &remote {
+        println!(
+            "its instances forward every call to the talus node '{}'{} (start it with `talus \
+             serve {} --key {}`, or under mpirun), waiting at most {} s for each answer",
+            remote.key,
+            if remote.connect.is_empty() {
+                " found by multicast scouting".to_string()
+            } else {
+                format!(" at {}", remote.connect.join(", "))
+            },
+            scene.display(),
+            remote.key,
+            remote.timeout
+        );
+    }
     if !summary.left_out.is_empty() {
         println!(
             "note: FMI 2.0 has no arrays; left out: {} (FMI 3.0, the C API and zenoh carry \

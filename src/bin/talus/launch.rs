@@ -107,12 +107,41 @@ impl Launch {
         !matches!(self, Launch::OneProcess)
     }
 
+    /// The number of ranks, on ranks.
+    #[cfg_attr(not(feature = "zenoh"), allow(dead_code))]
+    pub fn rank_count(&self) -> Option<usize> {
+        match self {
+            Launch::OneProcess => None,
+            #[cfg(feature = "mpi")]
+            Launch::Rank { universe, .. } => {
+                use mpi::topology::Communicator;
+                Some(universe.world().size() as usize)
+            }
+        }
+    }
+
     /// Ranks on this machine (1 for one process): they share its cores.
     pub fn local_ranks(&self) -> usize {
         match self {
             Launch::OneProcess => 1,
             #[cfg(feature = "mpi")]
             Launch::Rank { local_ranks, .. } => *local_ranks,
+        }
+    }
+
+    /// The ranks of an MPI run for a long-lived host (`talus serve`), once; `None`
+    /// in one process.
+    #[cfg_attr(not(feature = "zenoh"), allow(dead_code))]
+    pub fn take_ranks(&mut self) -> Result<Option<Box<dyn talus::engine::exchange::Ranks>>> {
+        match self {
+            Launch::OneProcess => Ok(None),
+            #[cfg(feature = "mpi")]
+            Launch::Rank { exchange, .. } => {
+                let exchange = exchange
+                    .take()
+                    .ok_or_else(|| anyhow::anyhow!("the ranks are taken already"))?;
+                Ok(Some(Box::new(exchange)))
+            }
         }
     }
 

@@ -105,6 +105,18 @@ enum Command {
         /// The talus shared library to pack (default: libtalus.so next to this program).
         #[arg(long)]
         library: Option<PathBuf>,
+        /// Pack a proxy FMU: its instances forward every call over zenoh to the
+        /// `talus serve` node with this key (the library needs the zenoh feature).
+        #[arg(long, value_name = "KEY")]
+        remote: Option<String>,
+        /// With --remote: zenoh endpoint of the node (repeatable), e.g.
+        /// tcp/cluster:7447; none: multicast scouting.
+        #[arg(long, requires = "remote")]
+        connect: Vec<String>,
+        /// With --remote: the longest wait for an answer to any call (a step
+        /// included), s, before it is an FMI error.
+        #[arg(long, requires = "remote", default_value_t = talus::fmi::remote_spec::DEFAULT_TIMEOUT)]
+        timeout: f64,
     },
     /// Serve a scene as a zenoh node (feature `zenoh`): queryables KEY/step,
     /// KEY/walls, KEY/info, KEY/state, publisher KEY/forces, liveliness token KEY.
@@ -253,7 +265,24 @@ fn main() -> Result<()> {
             output,
             fmi,
             library,
-        } => fmu::fmu(&scene, &output, fmi, library),
+            remote,
+            connect,
+            timeout,
+        } => {
+            let remote = match remote {
+                Some(key) => Some(
+                    talus::fmi::remote_spec::RemoteSpec {
+                        key,
+                        connect,
+                        timeout,
+                    }
+                    .checked()
+                    .map_err(|e| anyhow::anyhow!("--remote: {e}"))?,
+                ),
+                None => None,
+            };
+            fmu::fmu(&scene, &output, fmi, library, remote)
+        }
         Command::Bench {
             prepare_bed: Some(out),
             ..

@@ -18,8 +18,9 @@ use talus::scene::spec::UpdateInterval;
 use talus::scene::{Scene, Simulation};
 
 use crate::launch::Launch;
-use crate::run_outputs::{Checkpoints, Outputs, STOP_VOTE_STEPS};
+use crate::run_outputs::{Checkpoints, STOP_VOTE_STEPS};
 use crate::{checkpoint, expected};
+use talus::recording::Outputs;
 
 /// Loads a scene, printing its warnings.
 pub fn load(path: &Path) -> Result<Scene> {
@@ -256,7 +257,7 @@ fn run_loop(
                 particle_steps += stats.integrated as u64;
                 contact_sum += stats.contacts as u64;
                 if let Err(e) = out.record(sim, taken, false) {
-                    return ControlFlow::Break(Err(e));
+                    return ControlFlow::Break(Err(e.into()));
                 }
                 if checkpoints.due(sim, taken)
                     && let Err(e) =

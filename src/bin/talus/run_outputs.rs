@@ -1,15 +1,14 @@
-//! Where a run's outputs and checkpoints go: rank 0 (or the one process) writes
-//! them; on ranks every rank keeps the clocks and takes part in gathering the whole
-//! world for a row or a frame, and the whole state for a checkpoint.
+//! Where a run's checkpoints go: rank 0 (or the one process) writes them; on
+//! ranks every rank takes part in gathering the whole state for a checkpoint (the
+//! outputs: `talus::recording`).
 
-use std::borrow::Cow;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result};
 use talus::Real;
 use talus::checkpoint::{Checkpoint, RunProgress};
-use talus::output::{OutputClock, RunOutput};
+use talus::recording::Outputs;
 use talus::scene::{Scene, Simulation};
 
 use crate::checkpoint;
@@ -88,46 +87,5 @@ impl Checkpoints {
         };
         checkpoint::write(&self.dir, &checkpoint.to_bytes(self.fingerprint))
             .with_context(|| format!("cannot write a checkpoint in {}", self.dir.display()))
-    }
-}
-
-/// The outputs of a run: written by rank 0 (or the one process); every rank keeps
-/// the clock, since gathering the whole world for a row or a frame is collective.
-pub struct Outputs {
-    /// The files, on rank 0.
-    pub out: Option<RunOutput>,
-    pub clock: OutputClock,
-    /// The scene has a drum, whose samples need the whole world.
-    pub drum: bool,
-}
-
-impl Outputs {
-    /// [`RunOutput::record`] after a step of length `dt`, the whole world gathered
-    /// when a row, a frame or a drum's sample is due.
-    pub fn record(&mut self, sim: &Simulation, dt: Real, force: bool) -> Result<()> {
-        let t = sim.time();
-        let due = self.clock.due(t, dt, force);
-        self.clock.advance(due, t, dt);
-        // Rank 0's drum keeps its own clock of samples; it tells the others.
-        let sample = self.drum
-            && sim.rank().is_some()
-            && sim.any_rank(self.out.as_ref().is_some_and(|o| o.drum_samples_at(t, dt)));
-        // Otherwise only the walls are read, whose forces are the whole run's on
-        // every rank, and the bed's mass moments, the whole run's too.
-        let world = if due.any() || sample {
-            sim.whole_world()
-        } else {
-            Some(Cow::Borrowed(sim.world()))
-        };
-        if let (Some(out), Some(world)) = (&mut self.out, world) {
-            out.record(
-                &world,
-                || sim.mass_moments(),
-                dt,
-                sim.stats().contacts,
-                force,
-            )?;
-        }
-        Ok(())
     }
 }

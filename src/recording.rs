@@ -1,0 +1,67 @@
+//! A running simulation's output files, written by rank 0 (or the one process)
+//! with every rank taking part: each rank keeps the clock of rows and frames, since
+//! gathering the whole world for them is collective. `talus run` and the
+//! component record through it. A layer beside cosim: it uses scene and output.
+
+use std::borrow::Cow;
+use std::io;
+
+use crate::Real;
+use crate::analysis::DrumSummary;
+use crate::output::{OutputClock, RunOutput};
+use crate::scene::{Scene, Simulation};
+
+/// The outputs of a run: the files on rank 0, the clock on every rank.
+pub struct Outputs {
+    /// The files, on rank 0.
+    pub out: Option<RunOutput>,
+    pub clock: OutputClock,
+    /// The scene has a drum, whose samples need the whole world.
+    pub drum: bool,
+}
+
+impl Outputs {
+    /// [`RunOutput::record`] after a step of length `dt`, the whole world gathered
+    /// when a row, a frame or a drum's sample is due (collective on ranks).
+    pub fn record(&mut self, sim: &Simulation, dt: Real, force: bool) -> io::Result<()> {
+        let t = sim.time();
+        let due = self.clock.due(t, dt, force);
+        self.clock.advance(due, t, dt);
+        // Rank 0's drum keeps its own clock of samples; it tells the others.
+        let sample = self.drum
+            && sim.rank().is_some()
+            && sim.any_rank(self.out.as_ref().is_some_and(|o| o.drum_samples_at(t, dt)));
+        // Otherwise only the walls are read, whose forces are the whole run's on
+        // every rank, and the bed's mass moments, the whole run's too.
+        let world = if due.any() || sample {
+            sim.whole_world()
+        } else {
+            Some(Cow::Borrowed(sim.world()))
+        };
+        if let (Some(out), Some(world)) = (&mut self.out, world) {
+            out.record(
+                &world,
+                || sim.mass_moments(),
+                dt,
+                sim.stats().contacts,
+                force,
+            )?;
+        }
+        Ok(())
+    }
+
+    /// Writes the files of the run's end that read the whole world (the bed's, the
+    /// drum's summary; collective on ranks) and returns the drum's summary, on
+    /// rank 0.
+    pub fn finish(&mut self, sim: &Simulation, scene: &Scene) -> io::Result<Option<DrumSummary>> {
+        let whole = if scene.bed.is_some() || scene.drum.is_some() {
+            sim.whole_world()
+        } else {
+            None
+        };
+        match &mut self.out {
+            Some(out) => out.finish(whole.as_deref().unwrap_or(sim.world())),
+            None => Ok(None),
+        }
+    }
+}

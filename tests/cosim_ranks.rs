@@ -1,0 +1,231 @@
+//! The component on ranks (what `mpirun -np N talus serve` runs; here the ranks are
+//! threads talking through a `ThreadExchange`, the same words as over MPI): the
+//! same calls on every rank step one decomposed run whose outputs are one
+//! process's, states saved on N ranks restore on M ranks or in one process, and a
+//! step that diverges goes back on all ranks.
+//!
+//! Tolerances: particle states are one process's bits (each particle gathers its
+//! contacts in the same order on ranks); wall forces and torques are sums grouped
+//! by rank, equal to round-off: 1e-12 of the largest component.
+
+use std::path::Path;
+
+use talus::cosim::{Component, CosimError, VarRef};
+use talus::engine::exchange::ThreadExchange;
+use talus::scene::SimState;
+
+fn root() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+}
+
+const DRUM: &str = "examples/drum_fmu/drum.toml";
+
+/// Runs `calls` on a component of `scene` on each of `ranks` threads (on ranks),
+/// or in this thread (one process) when `ranks` is 0; the results in rank order.
+fn on_ranks<R: Send>(
+    ranks: usize,
+    scene: &str,
+    calls: impl Fn(&mut Component) -> R + Sync,
+) -> Vec<R> {
+    if ranks == 0 {
+        let mut c = Component::instantiate(root(), scene).unwrap();
+        return vec![calls(&mut c)];
+    }
+    std::thread::scope(|s| {
+        let handles: Vec<_> = ThreadExchange::group(ranks)
+            .into_iter()
+            .map(|exchange| {
+                let calls = &calls;
+                s.spawn(move || {
+                    let mut c =
+                        Component::instantiate_on_ranks(root(), scene, Box::new(exchange)).unwrap();
+                    calls(&mut c)
+                })
+            })
+            .collect();
+        handles.into_iter().map(|h| h.join().unwrap()).collect()
+    })
+}
+
+fn start(c: &mut Component) {
+    c.enter_initialization_mode(0.0).unwrap();
+    c.exit_initialization_mode().unwrap();
+}
+
+fn vector(c: &Component, name: &str) -> Vec<f64> {
+    c.get_real_vector(c.variable(name).unwrap()).unwrap()
+}
+
+fn integer(c: &Component, name: &str) -> i64 {
+    let var = c.variable(name).unwrap();
+    let mut out = [0];
+    c.get_integer(&[VarRef { var, element: 0 }], &mut out)
+        .unwrap();
+    out[0]
+}
+
+/// Turns the drum at `omega` for each of `steps` communication steps of `h`.
+fn turn(c: &mut Component, omega: &[f64], h: f64) {
+    let w = c.variable("drum.angular_velocity").unwrap();
+    for &o in omega {
+        c.set_real_vector(w, &[0.0, o, 0.0]).unwrap();
+        let t = vector(c, "time")[0];
+        c.do_step(t, h).unwrap();
+    }
+}
+
+/// What rank 0 reports: the wall's means and end forces, the facet forces, the
+/// bed's figures, and the whole state (collective: every rank calls it).
+#[derive(Clone, Debug)]
+struct Report {
+    walls: Vec<f64>,
+    facets: Vec<f64>,
+    kinetic: f64,
+    particles: i64,
+    time: f64,
+    state: Option<SimState>,
+}
+
+fn report(c: &Component) -> Report {
+    let walls = [
+        "drum.force",
+        "drum.torque",
+        "drum.force_end",
+        "drum.torque_end",
+    ]
+    .iter()
+    .flat_map(|n| vector(c, n))
+    .collect();
+    Report {
+        walls,
+        facets: vector(c, "drum.facet_force"),
+        kinetic: vector(c, "kinetic_energy")[0],
+        particles: integer(c, "particles"),
+        time: vector(c, "time")[0],
+        state: c.simulation().unwrap().whole_snapshot(),
+    }
+}
+
+/// Asserts that `a` (rank 0 of a run on ranks) is `b` (one process): the
+/// particles to the bit, the sums to round-off.
+fn assert_same_run(a: &Report, b: &Report) {
+    assert_eq!((a.time, a.particles), (b.time, b.particles));
+    let (sa, sb) = (a.state.as_ref().unwrap(), b.state.as_ref().unwrap());
+    assert_eq!(sa.steps, sb.steps);
+    let sorted = |s: &SimState| {
+        let p = &s.particles;
+        let mut rows: Vec<_> = (0..p.len())
+            .map(|i| (p.id[i], p.position[i], p.velocity[i], p.orientation[i]))
+            .collect();
+        rows.sort_by_key(|r| r.0);
+        rows
+    };
+    assert!(sorted(sa) == sorted(sb), "the particles are one process's");
+    for (name, x, y) in [
+        ("walls", &a.walls, &b.walls),
+        ("facets", &a.facets, &b.facets),
+    ] {
+        let scale = y.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        assert!(scale > 0.0, "{name}: some force");
+        for (u, v) in x.iter().zip(y) {
+            assert!((u - v).abs() <= 1e-12 * scale, "{name}: {u} against {v}");
+        }
+    }
+    assert!((a.kinetic - b.kinetic).abs() <= 1e-12 * b.kinetic);
+}
+
+#[test]
+fn the_drum_turned_on_two_and_three_ranks_is_the_drum_of_one_process() {
+    let omega = [3.0, 3.0, -2.0, 1.5];
+    let steps = |c: &mut Component| {
+        start(c);
+        turn(c, &omega, 0.01);
+        report(c)
+    };
+    let one = on_ranks(0, DRUM, steps).remove(0);
+    assert!(one.particles == 96 && one.state.as_ref().unwrap().steps > 1000);
+    for ranks in [2, 3] {
+        let reports = on_ranks(ranks, DRUM, steps);
+        assert_same_run(&reports[0], &one);
+        // Every rank holds the whole run's wall forces and figures.
+        for r in &reports[1..] {
+            assert!(r.state.is_none() && r.walls == reports[0].walls);
+            assert_eq!(
+                (r.particles, r.kinetic),
+                (one.particles, reports[0].kinetic)
+            );
+        }
+    }
+}
+
+#[test]
+fn a_state_saved_on_two_ranks_restores_on_three_ranks_and_in_one_process() {
+    let saved = on_ranks(2, DRUM, |c| {
+        start(c);
+        turn(c, &[3.0, 3.0], 0.01);
+        let state = c.save_state().unwrap();
+        c.state_to_bytes(&state)
+    });
+    assert_eq!(saved[0], saved[1], "every rank holds the whole state");
+    let bytes = &saved[0];
+    let resumed = |c: &mut Component| {
+        start(c);
+        let state = c.state_from_bytes(bytes).unwrap();
+        c.restore_state(&state).unwrap();
+        assert_eq!(vector(c, "time")[0], 0.02);
+        turn(c, &[-2.0, 1.0], 0.01);
+        report(c)
+    };
+    let one = on_ranks(0, DRUM, resumed).remove(0);
+    let three = on_ranks(3, DRUM, resumed);
+    assert_same_run(&three[0], &one);
+    // And the same as never having stopped, in one process.
+    let through = on_ranks(0, DRUM, |c| {
+        start(c);
+        turn(c, &[3.0, 3.0, -2.0, 1.0], 0.01);
+        report(c)
+    })
+    .remove(0);
+    assert_same_run(&one, &through);
+}
+
+#[test]
+fn a_step_that_diverges_on_ranks_goes_back_on_every_rank() {
+    let scene = "tests/scenes/overflowing.toml";
+    let run = |c: &mut Component| {
+        start(c);
+        c.do_step(0.0, 0.01).unwrap();
+        let before = c.simulation().unwrap().whole_snapshot();
+        // The beads reach the floor after about 45 ms.
+        let err = c.do_step(0.01, 0.1).unwrap_err();
+        assert!(matches!(err, CosimError::Diverged(_)), "{err}");
+        let after = c.simulation().unwrap().whole_snapshot();
+        c.do_step(0.01, 0.01).unwrap();
+        (
+            before,
+            after,
+            vector(c, "time")[0],
+            vector(c, "floor.force"),
+        )
+    };
+    let one = on_ranks(0, scene, run).remove(0);
+    let two = on_ranks(2, scene, run);
+    for (before, after, time, _) in two.iter().chain([&one]) {
+        assert_eq!(*time, 0.02);
+        if let (Some(before), Some(after)) = (before, after) {
+            assert!(before.particles.position == after.particles.position);
+            assert!(before.particles.velocity == after.particles.velocity);
+            assert_eq!(before.steps, after.steps);
+        }
+    }
+    let sorted = |s: &SimState| {
+        let mut x: Vec<_> = (0..s.particles.len())
+            .map(|i| (s.particles.id[i], s.particles.position[i]))
+            .collect();
+        x.sort_by_key(|r| r.0);
+        x
+    };
+    let (a, b) = (two[0].0.as_ref().unwrap(), one.0.as_ref().unwrap());
+    assert!(sorted(a) == sorted(b));
+    assert_eq!(two[0].3, two[1].3, "every rank the whole floor force");
+}
