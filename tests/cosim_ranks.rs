@@ -229,3 +229,43 @@ fn a_step_that_diverges_on_ranks_goes_back_on_every_rank() {
     assert!(sorted(a) == sorted(b));
     assert_eq!(two[0].3, two[1].3, "every rank the whole floor force");
 }
+
+/// Rank 0's readings of the whole world after `steps` steps of `h`: each
+/// variable's values.
+fn readings(ranks: usize, scene: &str, steps: usize, h: f64, names: &[&str]) -> Vec<Vec<f64>> {
+    let run = |c: &mut Component| {
+        start(c);
+        for k in 0..steps {
+            c.do_step(k as f64 * h, h).unwrap();
+        }
+        names.iter().map(|n| vector(c, n)).collect::<Vec<_>>()
+    };
+    on_ranks(ranks, scene, run).remove(0)
+}
+
+/// Equal to round-off: the whole world's figures are summed in the order rank 0
+/// gathered it (by id), one process's in its own.
+fn assert_close(a: &[Vec<f64>], b: &[Vec<f64>], names: &[&str]) {
+    for ((x, y), name) in a.iter().zip(b).zip(names) {
+        for (u, v) in x.iter().zip(y) {
+            assert!(
+                (u - v).abs() <= 1e-12 * v.abs().max(1e-300),
+                "{name}: {u} against {v}"
+            );
+        }
+    }
+}
+
+#[test]
+fn the_drum_and_bed_figures_on_ranks_are_one_process_figures() {
+    let names = ["angle_of_repose", "drive_torque", "shell.facet_force"];
+    let drum = "examples/drum/quasi2d.toml";
+    let one = readings(0, drum, 4, 0.025, &names);
+    assert!(one[0][0] > 0.0 && one[1][0] != 0.0, "{:?}", &one[..2]);
+    assert_close(&readings(2, drum, 4, 0.025, &names), &one, &names);
+    let names = ["bed_height", "porosity"];
+    let bed = "examples/fixed_bed/seed_bed.toml";
+    let one = readings(0, bed, 2, 0.05, &names);
+    assert!(one[0][0] > 0.0 && one[1][0] > 0.0, "{one:?}");
+    assert_close(&readings(3, bed, 2, 0.05, &names), &one, &names);
+}
