@@ -11,26 +11,72 @@ use crate::analysis::DrumSummary;
 use crate::output::{OutputClock, RunOutput};
 use crate::scene::{Scene, Simulation};
 
-/// The outputs of a run: the files on rank 0, the clock on every rank.
+/// The outputs of a run: the files on rank 0 (whose clock is the run's), the
+/// clock alone on the other ranks.
 pub struct Outputs {
-    /// The files, on rank 0.
-    pub out: Option<RunOutput>,
-    pub clock: OutputClock,
+    side: Side,
     /// The scene has a drum, whose samples need the whole world.
-    pub drum: bool,
+    drum: bool,
+}
+
+enum Side {
+    Files(Box<RunOutput>),
+    Clock(OutputClock),
 }
 
 impl Outputs {
+    /// Rank 0's outputs (or the one process's): `files`, `drum` when the scene has
+    /// a drum.
+    pub fn writing(files: RunOutput, drum: bool) -> Self {
+        Outputs {
+            side: Side::Files(Box::new(files)),
+            drum,
+        }
+    }
+
+    /// Another rank's: the clock of rank 0's files.
+    pub fn following(clock: OutputClock, drum: bool) -> Self {
+        Outputs {
+            side: Side::Clock(clock),
+            drum,
+        }
+    }
+
+    /// The files, on rank 0.
+    pub fn files(&mut self) -> Option<&mut RunOutput> {
+        match &mut self.side {
+            Side::Files(out) => Some(out),
+            Side::Clock(_) => None,
+        }
+    }
+
+    /// The files, on rank 0, for the run's last words.
+    pub fn into_files(self) -> Option<RunOutput> {
+        match self.side {
+            Side::Files(out) => Some(*out),
+            Side::Clock(_) => None,
+        }
+    }
+
+    fn clock(&self) -> &OutputClock {
+        match &self.side {
+            Side::Files(out) => out.clock(),
+            Side::Clock(clock) => clock,
+        }
+    }
+
     /// [`RunOutput::record`] after a step of length `dt`, the whole world gathered
     /// when a row, a frame or a drum's sample is due (collective on ranks).
     pub fn record(&mut self, sim: &Simulation, dt: Real, force: bool) -> io::Result<()> {
         let t = sim.time();
-        let due = self.clock.due(t, dt, force);
-        self.clock.advance(due, t, dt);
+        let due = self.clock().due(t, dt, force);
+        if let Side::Clock(clock) = &mut self.side {
+            clock.advance(due, t, dt);
+        }
         // Rank 0's drum keeps its own clock of samples; it tells the others.
         let sample = self.drum
             && sim.rank().is_some()
-            && sim.any_rank(self.out.as_ref().is_some_and(|o| o.drum_samples_at(t, dt)));
+            && sim.any_rank(matches!(&self.side, Side::Files(o) if o.drum_samples_at(t, dt)));
         // Otherwise only the walls are read, whose forces are the whole run's on
         // every rank, and the bed's mass moments, the whole run's too.
         let world = if due.any() || sample {
@@ -38,7 +84,7 @@ impl Outputs {
         } else {
             Some(Cow::Borrowed(sim.world()))
         };
-        if let (Some(out), Some(world)) = (&mut self.out, world) {
+        if let (Side::Files(out), Some(world)) = (&mut self.side, world) {
             out.record(
                 &world,
                 || sim.mass_moments(),
@@ -59,9 +105,9 @@ impl Outputs {
         } else {
             None
         };
-        match &mut self.out {
-            Some(out) => out.finish(whole.as_deref().unwrap_or(sim.world())),
-            None => Ok(None),
+        match &mut self.side {
+            Side::Files(out) => out.finish(whole.as_deref().unwrap_or(sim.world())),
+            Side::Clock(_) => Ok(None),
         }
     }
 }

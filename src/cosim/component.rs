@@ -320,22 +320,19 @@ impl Component {
         } else {
             let sim = self.sim.as_ref().expect("initialisation has a simulation");
             let out = &self.scene.spec.output;
-            let root = self.rank().is_none_or(|(rank, _)| rank == 0);
-            let files = if root {
-                Some(RunOutput::create(
+            let drum = self.scene.drum.is_some();
+            Some(if self.rank().is_none_or(|(rank, _)| rank == 0) {
+                let files = RunOutput::create(
                     &self.base_dir.join(&self.params.output_dir),
                     sim.world(),
                     out.frame_interval,
                     out.csv_interval,
                     self.scene.drum.as_ref(),
-                )?)
+                )?;
+                Outputs::writing(files, drum)
             } else {
-                None
-            };
-            Some(Outputs {
-                out: files,
-                clock: OutputClock::new(out.frame_interval, out.csv_interval, sim.time()),
-                drum: self.scene.drum.is_some(),
+                let clock = OutputClock::new(out.frame_interval, out.csv_interval, sim.time());
+                Outputs::following(clock, drum)
             })
         };
         self.check_orientations()?;

@@ -29,7 +29,7 @@ use crate::engine::decomposition::Decomposition;
 use crate::engine::exchange::Exchange;
 use crate::engine::rank::{ParticleRecord, RankStepper, Share, all_gather, gather_to_first};
 use crate::engine::{ContactHistory, StepStats};
-use crate::world::{MassMoments, World};
+use crate::world::{MassMoments, Particles, World};
 
 /// The ranks bisect the space again at a list renewal where the most loaded rank's
 /// cost exceeds the mean by this factor: a fifth more work on one rank costs a
@@ -370,15 +370,21 @@ impl Shares {
 /// A world like `like` holding `records`' particles in id order (the order of one
 /// process, whose ids ascend with insertion).
 fn world_of(like: &World, mut records: Vec<ParticleRecord>) -> World {
-    let mut world = like.clone();
-    let p = &mut world.particles;
-    p.clear_ghosts();
-    p.remove_where(|_| true);
     records.sort_unstable_by_key(|r| r.id);
+    let mut particles = Particles::default();
     for r in &records {
-        r.push_into(p);
+        r.push_into(&mut particles);
     }
-    world
+    // Everything but the particles as `like` holds it (not a copy of its share).
+    World {
+        materials: like.materials.clone(),
+        body_types: like.body_types.clone(),
+        particles,
+        walls: like.walls.clone(),
+        gravity: like.gravity,
+        time: like.time,
+        fluid: like.fluid.clone(),
+    }
 }
 
 /// The bed height one process measures, on ranks (collective): rank 0 measures

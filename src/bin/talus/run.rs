@@ -125,10 +125,11 @@ fn run_loop(
     let root = sim.rank().is_none_or(|(rank, _)| rank == 0);
     let frame_interval = scene.spec.output.frame_interval;
     let csv_interval = scene.spec.output.csv_interval;
+    let drum = scene.drum.is_some();
     let (mut out, before) = match start {
         None => {
-            let out = if root {
-                let out = RunOutput::create(
+            let mut out = if root {
+                let files = RunOutput::create(
                     dir,
                     sim.world(),
                     frame_interval,
@@ -136,32 +137,23 @@ fn run_loop(
                     scene.drum.as_ref(),
                 )
                 .with_context(|| format!("cannot write to {}", dir.display()))?;
-                Some(out)
+                Outputs::writing(files, drum)
             } else {
-                None
-            };
-            let clock = OutputClock::new(frame_interval, csv_interval, sim.time());
-            let mut out = Outputs {
-                out,
-                clock,
-                drum: scene.drum.is_some(),
+                Outputs::following(
+                    OutputClock::new(frame_interval, csv_interval, sim.time()),
+                    drum,
+                )
             };
             out.record(&sim, 0.0, true)?;
             (out, RunProgress::default())
         }
         Some(c) => {
-            let clock = c.output.clock(frame_interval, csv_interval);
             let out = if root {
-                let out = RunOutput::resume(dir, frame_interval, csv_interval, c.output)
+                let files = RunOutput::resume(dir, frame_interval, csv_interval, c.output)
                     .with_context(|| format!("cannot take up the outputs in {}", dir.display()))?;
-                Some(out)
+                Outputs::writing(files, drum)
             } else {
-                None
-            };
-            let out = Outputs {
-                out,
-                clock,
-                drum: scene.drum.is_some(),
+                Outputs::following(c.output.clock(frame_interval, csv_interval), drum)
             };
             if !quiet {
                 eprintln!(
@@ -311,7 +303,7 @@ fn run_loop(
     } else {
         None
     };
-    let Some(mut out) = out.out else {
+    let Some(mut out) = out.into_files() else {
         return match blown_up {
             Some(message) => bail!("{}: the run diverged: {message}", scene.file.display()),
             None => Ok(()),

@@ -73,7 +73,7 @@ impl Checkpoints {
     ) -> Result<()> {
         let state = sim.whole_snapshot();
         self.last = Instant::now();
-        let (Some(state), Some(out)) = (state, &mut out.out) else {
+        let (Some(state), Some(out)) = (state, out.files()) else {
             return Ok(());
         };
         let checkpoint = Checkpoint {
