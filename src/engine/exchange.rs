@@ -65,10 +65,18 @@ pub trait Ranks: Exchange + Send + std::fmt::Debug {
     /// An exchange among the same ranks, for a new simulation (collective: every
     /// rank calls it at the same point).
     fn another(&self) -> Box<dyn Ranks>;
+
+    /// Rank 0's `message` on every rank (the others' `message` is ignored), the
+    /// other ranks waiting for it however long rank 0 takes: how a host hands its
+    /// requests to ranks that idle in between. Collective; [`broadcast_bytes`]
+    /// unless an exchange can wait without keeping a core busy.
+    fn announce(&self, message: &[u8]) -> Vec<u8> {
+        broadcast_bytes(self, message)
+    }
 }
 
 /// Rank 0's `words` on every rank (collective; the others' `words` are ignored).
-pub fn broadcast_words(exchange: &dyn Exchange, words: Vec<u64>) -> Vec<u64> {
+pub fn broadcast_words<E: Exchange + ?Sized>(exchange: &E, words: Vec<u64>) -> Vec<u64> {
     let mut outgoing = vec![Vec::new(); exchange.size()];
     if exchange.rank() == 0 {
         outgoing.fill(words);
@@ -81,7 +89,7 @@ pub fn broadcast_words(exchange: &dyn Exchange, words: Vec<u64>) -> Vec<u64> {
 }
 
 /// Rank 0's `bytes` on every rank (collective), as [`broadcast_words`].
-pub fn broadcast_bytes(exchange: &dyn Exchange, bytes: &[u8]) -> Vec<u8> {
+pub fn broadcast_bytes<E: Exchange + ?Sized>(exchange: &E, bytes: &[u8]) -> Vec<u8> {
     let mut words = vec![bytes.len() as u64];
     words.extend(bytes.chunks(8).map(|c| {
         let mut w = [0u8; 8];

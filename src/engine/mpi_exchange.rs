@@ -6,6 +6,9 @@ use mpi::Count;
 use mpi::datatype::{Partition, PartitionMut};
 use mpi::environment::{Threading, Universe};
 use mpi::topology::SimpleCommunicator;
+use std::time::{Duration, Instant};
+
+use mpi::point_to_point::{Destination, MatchedReceiveVec, Source};
 use mpi::traits::{Communicator, CommunicatorCollectives};
 
 use super::exchange::{Exchange, Ranks};
@@ -112,6 +115,15 @@ impl Exchange for MpiExchange {
     }
 }
 
+/// The tag of [`Ranks::announce`]'s messages.
+const ANNOUNCE: mpi::Tag = 7001;
+
+/// How long a rank waiting for an announcement polls without sleeping (requests
+/// of a co-simulation master often follow each other closely), and the longest
+/// sleep between polls after that.
+const SPIN: Duration = Duration::from_micros(200);
+const LONGEST_NAP: Duration = Duration::from_millis(1);
+
 impl Ranks for MpiExchange {
     /// A duplicate of the communicator (`MPI_Comm_dup`, collective): messages of
     /// the new exchange never meet those of this one.
@@ -119,5 +131,34 @@ impl Ranks for MpiExchange {
         Box::new(MpiExchange {
             comm: self.comm.duplicate(),
         })
+    }
+
+    /// Point to point from rank 0; the others probe for it, sleeping between
+    /// probes once it is late (an MPI collective would poll a core at full speed
+    /// for as long as rank 0 waits for its next request).
+    fn announce(&self, message: &[u8]) -> Vec<u8> {
+        if self.rank() == 0 {
+            for r in 1..self.comm.size() {
+                self.comm
+                    .process_at_rank(r)
+                    .send_with_tag(message, ANNOUNCE);
+            }
+            return message.to_vec();
+        }
+        let first = self.comm.process_at_rank(0);
+        let since = Instant::now();
+        let mut nap = Duration::from_micros(10);
+        loop {
+            if let Some(sent) = first.immediate_matched_probe_with_tag(ANNOUNCE) {
+                let (bytes, _) = sent.matched_receive_vec::<u8>();
+                return bytes;
+            }
+            if since.elapsed() > SPIN {
+                std::thread::sleep(nap);
+                nap = (nap * 2).min(LONGEST_NAP);
+            } else {
+                std::hint::spin_loop();
+            }
+        }
     }
 }

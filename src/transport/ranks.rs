@@ -6,7 +6,7 @@
 //! requests read what rank 0 holds and are answered by it alone.
 
 use crate::cosim::{Component, CosimError};
-use crate::engine::exchange::{Ranks, broadcast_bytes};
+use crate::engine::exchange::Ranks;
 
 use super::Service;
 
@@ -48,7 +48,7 @@ impl Service {
         if let Some(ranks) = self.ranks.as_ref().filter(|r| r.rank() == 0) {
             let mut message = vec![call as u8];
             message.extend_from_slice(payload);
-            broadcast_bytes(&**ranks, &message);
+            ranks.announce(&message);
         }
     }
 
@@ -61,7 +61,7 @@ impl Service {
             .expect("a service on ranks follows rank 0");
         assert_ne!(ranks.rank(), 0, "rank 0 leads");
         loop {
-            let message = broadcast_bytes(&*ranks, &[]);
+            let message = ranks.announce(&[]);
             let (&call, payload) = message.split_first().expect("a call byte");
             match Call::of(call).expect("rank 0 sends known calls") {
                 Call::Stop => break,
