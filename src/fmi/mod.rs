@@ -14,7 +14,12 @@
 //!
 //! Each instance owns its worker threads (see [`crate::cosim::pool`]); after
 //! `FreeInstance` returns, no thread of the library runs, so a master may `dlclose`
-//! it and load it again.
+//! it and load it again. A proxy FMU's instances (`resources/remote.toml`, see
+//! [`remote_spec`]) forward every call to a `talus serve` node over zenoh; zenoh
+//! keeps its runtime's threads for the life of the process, whose thread-local
+//! destructors keep glibc from unloading the library at `dlclose` (fmpy frees the
+//! library after each simulation; the tests simulate proxies and local FMUs in turn
+//! in one process).
 
 pub mod description;
 mod fmi2;

@@ -55,3 +55,30 @@ impl RemoteSpec {
         Ok(self)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_spec_round_trips_and_bad_ones_say_what_is_wrong() {
+        let spec = RemoteSpec {
+            key: "talus/drum".into(),
+            connect: vec!["tcp/10.0.0.5:7447".into()],
+            timeout: 12.5,
+        };
+        assert_eq!(RemoteSpec::from_toml(&spec.to_toml()).unwrap(), spec);
+        let defaults = RemoteSpec::from_toml("key = \"talus/x\"").unwrap();
+        assert!(defaults.connect.is_empty() && defaults.timeout == DEFAULT_TIMEOUT);
+        for (text, words) in [
+            ("key = \"/\"", "the key is empty"),
+            ("key = \"k\"\ntimeout = 0.0", "not a positive number"),
+            ("key = \"k\"\ntimeout = nan", "not a positive number"),
+            ("key = \"k\"\nport = 7447", "unknown field `port`"),
+            ("connect = []", "missing field `key`"),
+        ] {
+            let err = RemoteSpec::from_toml(text).unwrap_err();
+            assert!(err.starts_with(REMOTE_FILE) && err.contains(words), "{err}");
+        }
+    }
+}

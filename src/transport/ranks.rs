@@ -5,7 +5,7 @@
 //! stay one decomposed run (see [`crate::cosim`]'s component on ranks). The other
 //! requests read what rank 0 holds and are answered by it alone.
 
-use crate::cosim::{Component, CosimError};
+use crate::cosim::{Component, CosimError, Mode};
 use crate::engine::exchange::Ranks;
 
 use super::Service;
@@ -71,17 +71,22 @@ impl Service {
                 Call::Life => drop(self.call(payload)),
             }
         }
-        let mut component = self.component;
-        component.terminate()?;
-        Ok(component)
+        end(self.component)
     }
 
     /// Ends serving: on rank 0 of ranks tells the others to stop, then terminates
-    /// the component (collective on ranks); returns it.
+    /// the component if it runs (collective on ranks); returns it.
     pub fn finish(self) -> Result<Component, CosimError> {
         self.tell_ranks(Call::Stop, &[]);
-        let mut component = self.component;
-        component.terminate()?;
-        Ok(component)
+        end(self.component)
     }
+}
+
+/// Terminates `component` (writes its outputs) unless a master already did, or
+/// reset it and left it before initialisation.
+fn end(mut component: Component) -> Result<Component, CosimError> {
+    if matches!(component.mode(), Mode::Initialisation | Mode::Step) {
+        component.terminate()?;
+    }
+    Ok(component)
 }

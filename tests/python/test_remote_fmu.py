@@ -49,6 +49,10 @@ def test_the_proxy_fmu_simulates_on_two_ranks_as_the_local_fmu(fmus, ranks_serve
                       (remote["kinetic_energy"], local["kinetic_energy"])]:
         scale = np.abs(want).max()
         assert scale > 0 and np.all(np.abs(got - want) <= 1e-12 * scale), (got, want)
+    # The master terminated the node's component; the node still stops cleanly.
+    ranks_server.stop()
+    out, err = ranks_server.process.communicate()
+    assert "stopped at t = 0.1" in out and "MPI_ABORT" not in err, (out, err)
 
 
 def test_states_of_the_node_roll_back_through_the_proxy(ranks_server, tmp_path):
