@@ -269,3 +269,28 @@ fn the_drum_and_bed_figures_on_ranks_are_one_process_figures() {
     assert!(one[0][0] > 0.0 && one[1][0] > 0.0, "{one:?}");
     assert_close(&readings(3, bed, 2, 0.05, &names), &one, &names);
 }
+
+#[test]
+fn a_step_whose_outputs_rank_0_cannot_write_fails_on_every_rank() {
+    let out = std::env::temp_dir().join(format!("talus-cosim-ranks-out-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&out);
+    let results = on_ranks(2, DRUM, |c| {
+        let var = c.variable("output_dir").unwrap();
+        c.set_string(&[VarRef { var, element: 0 }], &[out.to_str().unwrap()])
+            .unwrap();
+        start(c);
+        // Rank 0 made the directories; a file where the frames go fails the first frame.
+        if c.rank() == Some((0, 2)) {
+            std::fs::remove_dir_all(out.join("frames")).unwrap();
+            std::fs::write(out.join("frames"), b"not a directory").unwrap();
+        }
+        let err = c.do_step(0.0, 0.01).unwrap_err();
+        (err.to_string(), vector(c, "time")[0])
+    });
+    assert!(
+        matches!(&results[..], [(a, t), (b, u)] if t == u && a.starts_with("output")
+        && b.contains("rank 0 could not write")),
+        "{results:?}"
+    );
+    let _ = std::fs::remove_dir_all(&out);
+}

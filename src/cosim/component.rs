@@ -502,7 +502,18 @@ impl Component {
             return Err(CosimError::Diverged(problem));
         }
         self.gather();
+        // Every rank fails a step that failed to write on rank 0, so that a host
+        // that puts the inputs back after a failed step does so on every rank.
+        let written_everywhere = match &self.sim {
+            Some(sim) if on_ranks => !sim.any_rank(result.is_err()),
+            _ => true,
+        };
         result?;
+        if !written_everywhere {
+            return Err(CosimError::Output(std::io::Error::other(
+                "rank 0 could not write the outputs of the step",
+            )));
+        }
         let sim = self
             .sim
             .as_ref()

@@ -280,13 +280,20 @@ impl RunOutput {
         // A forced record at a time already written (the end of a run that landed on
         // a row or frame) writes nothing twice.
         let due = self.clock.due(t, dt, force);
+        let written = self.write_due(due, world, contacts);
+        // The clock moves on whether or not the files took the rows: on ranks the
+        // others' clocks did (they gather the whole world for rank 0 by them).
+        self.clock.advance(due, t, dt);
+        written
+    }
+
+    fn write_due(&mut self, due: Due, world: &World, contacts: usize) -> io::Result<()> {
         if due.rows {
             self.write_rows(world, contacts)?;
         }
         if due.frame {
             self.write_frame(world)?;
         }
-        self.clock.advance(due, t, dt);
         Ok(())
     }
 
