@@ -294,3 +294,23 @@ fn a_step_whose_outputs_rank_0_cannot_write_fails_on_every_rank() {
     );
     let _ = std::fs::remove_dir_all(&out);
 }
+
+#[test]
+fn output_files_rank_0_cannot_create_fail_initialisation_on_every_rank() {
+    let file = std::env::temp_dir().join(format!("talus-cosim-ranks-file-{}", std::process::id()));
+    std::fs::write(&file, b"a file, not a directory").unwrap();
+    let results = on_ranks(2, DRUM, |c| {
+        let var = c.variable("output_dir").unwrap();
+        c.set_string(&[VarRef { var, element: 0 }], &[file.to_str().unwrap()])
+            .unwrap();
+        c.enter_initialization_mode(0.0).unwrap();
+        let err = c.exit_initialization_mode().unwrap_err().to_string();
+        (err, c.mode())
+    });
+    assert!(
+        matches!(&results[..], [(a, m), (b, n)] if m == n && a.starts_with("output")
+        && b.contains("rank 0 could not create")),
+        "{results:?}"
+    );
+    let _ = std::fs::remove_file(&file);
+}

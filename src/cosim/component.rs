@@ -290,7 +290,14 @@ impl Component {
             )));
         }
         let pool =
-            JoinedPool::new(self.params.threads).map_err(|e| CosimError::Threads(e.to_string()))?;
+            JoinedPool::new(self.params.threads).map_err(|e| CosimError::Threads(e.to_string()));
+        if self.failed_anywhere(pool.is_err()) {
+            pool?;
+            return Err(CosimError::Ranks(
+                "another rank could not start its worker threads".into(),
+            ));
+        }
+        let pool = pool?;
         let exchange = self.ranks.as_ref().map(|r| r.another());
         let scene = &self.scene;
         let mut sim = pool.install(move || new_simulation(scene, exchange, None))?;
@@ -321,19 +328,24 @@ impl Component {
             let sim = self.sim.as_ref().expect("initialisation has a simulation");
             let out = &self.scene.spec.output;
             let drum = self.scene.drum.is_some();
-            Some(if self.rank().is_none_or(|(rank, _)| rank == 0) {
-                let files = RunOutput::create(
+            let output = if self.rank().is_none_or(|(rank, _)| rank == 0) {
+                RunOutput::create(
                     &self.base_dir.join(&self.params.output_dir),
                     sim.world(),
                     out.frame_interval,
                     out.csv_interval,
                     self.scene.drum.as_ref(),
-                )?;
-                Outputs::writing(files, drum)
+                )
+                .map(|files| Outputs::writing(files, drum))
             } else {
                 let clock = OutputClock::new(out.frame_interval, out.csv_interval, sim.time());
-                Outputs::following(clock, drum)
-            })
+                Ok(Outputs::following(clock, drum))
+            };
+            if self.failed_anywhere(output.is_err()) {
+                output?;
+                return Err(rank_0_output_error("create the output files"));
+            }
+            output.ok()
         };
         self.check_orientations()?;
         let sim = self
@@ -504,15 +516,9 @@ impl Component {
         self.gather();
         // Every rank fails a step that failed to write on rank 0, so that a host
         // that puts the inputs back after a failed step does so on every rank.
-        let written_everywhere = match &self.sim {
-            Some(sim) if on_ranks => !sim.any_rank(result.is_err()),
-            _ => true,
-        };
-        result?;
-        if !written_everywhere {
-            return Err(CosimError::Output(std::io::Error::other(
-                "rank 0 could not write the outputs of the step",
-            )));
+        if self.failed_anywhere(result.is_err()) {
+            result?;
+            return Err(rank_0_output_error("write the outputs of the step"));
         }
         let sim = self
             .sim
@@ -543,8 +549,14 @@ impl Component {
             "initialisation, step",
         )?;
         if let (Some(out), Some(sim)) = (&mut self.output, &self.sim) {
-            out.record(sim, 0.0, true)?;
-            out.finish(sim, &self.scene)?;
+            // Both collective on ranks: each is made whether or not the other wrote.
+            let recorded = out.record(sim, 0.0, true);
+            let finished = out.finish(sim, &self.scene).map(drop);
+            let written = recorded.and(finished);
+            if self.failed_anywhere(written.is_err()) {
+                written?;
+                return Err(rank_0_output_error("write the last outputs"));
+            }
         }
         self.output = None;
         self.mode = Mode::Terminated;
@@ -636,6 +648,11 @@ impl Component {
     pub fn wall_means(&self) -> &[WallMeans] {
         &self.means
     }
+}
+
+/// The error of the ranks whose rank 0 could not `what`.
+fn rank_0_output_error(what: &str) -> CosimError {
+    CosimError::Output(std::io::Error::other(format!("rank 0 could not {what}")))
 }
 
 fn initial_drives(scene: &Scene) -> Vec<WallDrive> {

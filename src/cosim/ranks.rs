@@ -56,6 +56,17 @@ impl Component {
         self.ranks.as_ref().map(|r| (r.rank(), r.size()))
     }
 
+    /// Whether `failed` holds on any rank: collective on ranks (a call that fails
+    /// on one rank, rank 0 writing the files, must fail on all, or they would part
+    /// ways in the collectives that follow); `failed` in one process.
+    pub(super) fn failed_anywhere(&self, failed: bool) -> bool {
+        let Some(ranks) = &self.ranks else {
+            return failed;
+        };
+        let all = ranks.all_to_all_words(vec![vec![failed as u64]; ranks.size()]);
+        all.iter().flatten().any(|&w| w != 0)
+    }
+
     /// The whole run's state made of every rank's `share` (collective on ranks):
     /// gathered on rank 0 and sent back to all.
     pub(super) fn whole_state(&self, share: ShareState) -> SimState {
