@@ -199,3 +199,27 @@ fn bench_runs_on_part_of_the_shipped_settled_bed() {
     assert_eq!(out.matches("s per thousand body types").count(), 3, "{out}");
     assert!(out.contains("125 body types of 20 shapes step at"), "{out}");
 }
+
+#[test]
+fn bad_remote_fmu_options_are_refused_with_the_reason() {
+    let out = std::env::temp_dir().join(format!("talus-cli-remote-{}.fmu", std::process::id()));
+    let out = out.to_str().unwrap();
+    let scene = "examples/drum_fmu/drum.toml";
+    for (args, words) in [
+        (vec!["--remote", "/"], "--remote: the key is empty"),
+        (
+            vec!["--remote", "talus/drum", "--timeout", "0"],
+            "--remote: timeout 0 s is not a positive number",
+        ),
+        (
+            vec!["--connect", "tcp/127.0.0.1:7447"],
+            "the following required arguments were not provided",
+        ),
+    ] {
+        let mut all = vec!["fmu", scene, "-o", out];
+        all.extend(args);
+        let (ok, _, err) = talus(&all);
+        assert!(!ok && err.contains(words), "{all:?}: {err}");
+        assert!(!std::path::Path::new(out).exists());
+    }
+}

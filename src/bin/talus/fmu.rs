@@ -30,6 +30,10 @@ pub fn fmu(
 ) -> Result<()> {
     let library = match library {
         Some(l) => l,
+        None if remote.is_some() && !cfg!(feature = "zenoh") => bail!(
+            "--remote: this talus was built without the zenoh feature, so its library cannot \
+             forward calls to a node (cargo build --release --features zenoh, or give --library)"
+        ),
         None => default_library()?,
     };
     let version = if fmi == 3 {
