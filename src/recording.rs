@@ -10,6 +10,7 @@ use crate::Real;
 use crate::analysis::DrumSummary;
 use crate::output::{OutputClock, RunOutput};
 use crate::scene::{Scene, Simulation};
+use crate::world::World;
 
 /// The outputs of a run: the files on rank 0 (whose clock is the run's), the
 /// clock alone on the other ranks.
@@ -100,14 +101,21 @@ impl Outputs {
     /// drum's summary; collective on ranks) and returns the drum's summary, on
     /// rank 0.
     pub fn finish(&mut self, sim: &Simulation, scene: &Scene) -> io::Result<Option<DrumSummary>> {
-        let whole = if scene.bed.is_some() || scene.drum.is_some() {
-            sim.whole_world()
-        } else {
-            None
-        };
+        let whole = world_at_the_end(sim, scene);
         match &mut self.side {
             Side::Files(out) => out.finish(whole.as_deref().unwrap_or(sim.world())),
             Side::Clock(_) => Ok(None),
         }
+    }
+}
+
+/// The whole world the files of a run's end read (the bed's, the drum's summary):
+/// gathered on rank 0 when the scene has a bed or a drum (collective on ranks; the
+/// world itself in one process), `None` otherwise and on the other ranks.
+pub fn world_at_the_end<'a>(sim: &'a Simulation, scene: &Scene) -> Option<Cow<'a, World>> {
+    if scene.bed.is_some() || scene.drum.is_some() {
+        sim.whole_world()
+    } else {
+        None
     }
 }

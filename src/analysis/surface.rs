@@ -28,9 +28,14 @@ pub struct SurfaceFit {
 }
 
 impl SurfaceFit {
+    /// Inclination to the horizontal, rad (0 to π/2).
+    pub fn angle(&self) -> Real {
+        self.slope.atan().abs()
+    }
+
     /// Inclination to the horizontal, degrees (0 to 90).
     pub fn angle_degrees(&self) -> Real {
-        self.slope.atan().abs().to_degrees()
+        self.angle().to_degrees()
     }
 
     /// Signed height of point `(h, v)` above the line, measured along the line's

@@ -137,9 +137,7 @@ impl Component {
             Role::DrivePower => self.drum_means().1,
             Role::AngleOfRepose => match (sim, &self.scene.drum, &self.gathered) {
                 (Some(_), Some(_), Some(g)) => g.angle_of_repose,
-                (Some(s), Some(d), None) => {
-                    d.surface(s.world()).map_or(0.0, |f| f.slope.atan().abs())
-                }
+                (Some(s), Some(d), None) => d.surface(s.world()).map_or(0.0, |f| f.angle()),
                 _ => 0.0,
             },
             Role::BedHeight

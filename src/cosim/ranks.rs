@@ -132,7 +132,7 @@ impl Component {
                     .drum
                     .as_ref()
                     .and_then(|d| d.surface(&world))
-                    .map_or(0.0, |f| f.slope.atan().abs()),
+                    .map_or(0.0, |f| f.angle()),
                 bed: scene.bed.as_ref().and_then(|b| bed_figures(&world, b).ok()),
             })
         })();

@@ -2,13 +2,13 @@
 //! words of each message moved by one `MPI_Alltoallv` after the counts by one
 //! `MPI_Alltoall`.
 
+use std::time::{Duration, Instant};
+
 use mpi::Count;
 use mpi::datatype::{Partition, PartitionMut};
 use mpi::environment::{Threading, Universe};
-use mpi::topology::SimpleCommunicator;
-use std::time::{Duration, Instant};
-
 use mpi::point_to_point::{Destination, MatchedReceiveVec, Source};
+use mpi::topology::SimpleCommunicator;
 use mpi::traits::{Communicator, CommunicatorCollectives};
 
 use super::exchange::{Exchange, Ranks};

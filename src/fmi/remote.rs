@@ -304,21 +304,12 @@ impl Slave for Remote {
     }
 
     fn restore_state(&mut self, state: &FmuState) -> Result<(), String> {
-        match state {
-            FmuState::Remote(bytes) => self.call(Request::RestoreState(bytes.clone())).map(drop),
-            FmuState::Local(_) => {
-                Err("a state of a local FMU instance given to a remote one".into())
-            }
-        }
+        let bytes = state.remote()?.to_vec();
+        self.call(Request::RestoreState(bytes)).map(drop)
     }
 
     fn state_to_bytes(&self, state: &FmuState) -> Result<Vec<u8>, String> {
-        match state {
-            FmuState::Remote(bytes) => Ok(bytes.clone()),
-            FmuState::Local(_) => {
-                Err("a state of a local FMU instance given to a remote one".into())
-            }
-        }
+        state.remote().map(<[u8]>::to_vec)
     }
 
     /// The node checks the bytes when they are restored; here only that they are a

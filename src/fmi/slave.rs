@@ -13,6 +13,29 @@ pub(crate) enum FmuState {
     Remote(Vec<u8>),
 }
 
+impl FmuState {
+    /// The state of a local instance; an error for a remote one's.
+    fn local(&self) -> Result<&ComponentState, String> {
+        match self {
+            FmuState::Local(state) => Ok(state),
+            FmuState::Remote(_) => {
+                Err("a state of a remote FMU instance given to a local one".into())
+            }
+        }
+    }
+
+    /// The bytes of a remote instance's state; an error for a local one's.
+    #[cfg_attr(not(feature = "zenoh"), allow(dead_code))]
+    pub(crate) fn remote(&self) -> Result<&[u8], String> {
+        match self {
+            FmuState::Remote(bytes) => Ok(bytes),
+            FmuState::Local(_) => {
+                Err("a state of a local FMU instance given to a remote one".into())
+            }
+        }
+    }
+}
+
 /// The calls of the co-simulation life cycle an FMU instance makes.
 pub(crate) trait Slave: Send {
     fn variables(&self) -> &[Variable];
@@ -44,8 +67,6 @@ pub(crate) trait Slave: Send {
 fn text(e: impl ToString) -> String {
     e.to_string()
 }
-
-const NOT_LOCAL: &str = "a state of a remote FMU instance";
 
 impl Slave for Component {
     fn variables(&self) -> &[Variable] {
@@ -124,17 +145,11 @@ impl Slave for Component {
     }
 
     fn restore_state(&mut self, state: &FmuState) -> Result<(), String> {
-        match state {
-            FmuState::Local(state) => Component::restore_state(self, state).map_err(text),
-            FmuState::Remote(_) => Err(format!("{NOT_LOCAL} given to a local one")),
-        }
+        Component::restore_state(self, state.local()?).map_err(text)
     }
 
     fn state_to_bytes(&self, state: &FmuState) -> Result<Vec<u8>, String> {
-        match state {
-            FmuState::Local(state) => Ok(Component::state_to_bytes(self, state)),
-            FmuState::Remote(_) => Err(format!("{NOT_LOCAL} given to a local one")),
-        }
+        Ok(Component::state_to_bytes(self, state.local()?))
     }
 
     fn state_from_bytes(&self, bytes: &[u8]) -> Result<FmuState, String> {

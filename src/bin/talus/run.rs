@@ -12,6 +12,7 @@ use anyhow::{Context, Result, bail};
 use indicatif::{ProgressBar, ProgressStyle};
 use talus::checkpoint::{Checkpoint, RunProgress};
 use talus::output::{EnergySummary, OutputClock, RunOutput, StageSummary, Summary, WallSummary};
+use talus::recording::{Outputs, world_at_the_end};
 use talus::scene::energy_balance::EnergyBalance;
 use talus::scene::energy_ledger::EnergyReport;
 use talus::scene::spec::UpdateInterval;
@@ -20,7 +21,6 @@ use talus::scene::{Scene, Simulation};
 use crate::launch::Launch;
 use crate::run_outputs::{Checkpoints, STOP_VOTE_STEPS};
 use crate::{checkpoint, expected};
-use talus::recording::Outputs;
 
 /// Loads a scene, printing its warnings.
 pub fn load(path: &Path) -> Result<Scene> {
@@ -298,11 +298,7 @@ fn run_loop(
     }
     // The bed's files and the drum's summary read the whole world: every rank
     // takes part in gathering it; rank 0 writes.
-    let whole = if scene.bed.is_some() || scene.drum.is_some() {
-        sim.whole_world()
-    } else {
-        None
-    };
+    let whole = world_at_the_end(&sim, scene);
     let Some(mut out) = out.into_files() else {
         return match blown_up {
             Some(message) => bail!("{}: the run diverged: {message}", scene.file.display()),

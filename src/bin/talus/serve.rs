@@ -47,11 +47,8 @@ fn serve_in(launch: &mut Launch, scene: &Path, options: ServeOptions) -> Result<
     let out = options
         .out
         .unwrap_or_else(|| component.scene().output_dir());
-    let set = |component: &mut Component, name: &str, value: &str| -> Result<()> {
-        let var = component.variable(name)?;
-        Ok(component.set_string(&[VarRef { var, element: 0 }], &[value])?)
-    };
-    set(&mut component, "output_dir", &out.to_string_lossy())?;
+    let var = component.variable("output_dir")?;
+    component.set_string(&[VarRef { var, element: 0 }], &[&out.to_string_lossy()])?;
     if component.scene().spec.simulation.threads == 0 && ranks.is_some() {
         // The ranks on this machine share its cores.
         let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
