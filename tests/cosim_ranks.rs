@@ -2,11 +2,15 @@
 //! threads talking through a `ThreadExchange`, the same words as over MPI): the
 //! same calls on every rank step one decomposed run whose outputs are one
 //! process's, states saved on N ranks restore on M ranks or in one process, and a
-//! step that diverges goes back on all ranks.
+//! step that diverges goes back on all ranks; a coupled fluid's outputs are one
+//! process's.
 //!
 //! Tolerances: particle states are one process's bits (each particle gathers its
 //! contacts in the same order on ranks); wall forces and torques are sums grouped
-//! by rank, equal to round-off: 1e-12 of the largest component.
+//! by rank, equal to round-off: 1e-12 of the largest component. So are a coupled
+//! fluid's momentum sources (each rank sums its particles' drag impulse); its
+//! solid fractions, mean particle velocities and each particle's drag are one
+//! process's bits.
 
 use std::path::Path;
 
@@ -106,21 +110,36 @@ fn report(c: &Component) -> Report {
     }
 }
 
+/// A particle's id, position, velocity and orientation.
+type ParticleRow = (u64, [f64; 3], [f64; 3], [f64; 4]);
+
+/// Each particle's row, by id.
+fn particle_rows(s: &SimState) -> Vec<ParticleRow> {
+    let p = &s.particles;
+    let mut rows: Vec<_> = (0..p.len())
+        .map(|i| {
+            (
+                p.id[i],
+                p.position[i].coords.into(),
+                p.velocity[i].into(),
+                p.orientation[i].coords.into(),
+            )
+        })
+        .collect();
+    rows.sort_by_key(|r| r.0);
+    rows
+}
+
 /// Asserts that `a` (rank 0 of a run on ranks) is `b` (one process): the
 /// particles to the bit, the sums to round-off.
 fn assert_same_run(a: &Report, b: &Report) {
     assert_eq!((a.time, a.particles), (b.time, b.particles));
     let (sa, sb) = (a.state.as_ref().unwrap(), b.state.as_ref().unwrap());
     assert_eq!(sa.steps, sb.steps);
-    let sorted = |s: &SimState| {
-        let p = &s.particles;
-        let mut rows: Vec<_> = (0..p.len())
-            .map(|i| (p.id[i], p.position[i], p.velocity[i], p.orientation[i]))
-            .collect();
-        rows.sort_by_key(|r| r.0);
-        rows
-    };
-    assert!(sorted(sa) == sorted(sb), "the particles are one process's");
+    assert!(
+        particle_rows(sa) == particle_rows(sb),
+        "the particles are one process's"
+    );
     for (name, x, y) in [
         ("walls", &a.walls, &b.walls),
         ("facets", &a.facets, &b.facets),
@@ -313,4 +332,144 @@ fn output_files_rank_0_cannot_create_fail_initialisation_on_every_rank() {
         "{results:?}"
     );
     let _ = std::fs::remove_file(&file);
+}
+
+const COLUMN: &str = "tests/scenes/fluid_column.toml";
+
+/// The gas a coupled code might set at its `k`-th exchange: a side wind of 3 m/s
+/// turning with `k` and from cell to cell over an upward 2 m/s, so that the
+/// particles cross the ranks' boundaries between two updates of their shares
+/// (every 5 DEM steps; 100 per exchange).
+fn wind(cells: usize, k: usize) -> Vec<f64> {
+    (0..cells)
+        .flat_map(|c| {
+            let a = 0.7 * k as f64 + 0.3 * c as f64;
+            [3.0 * a.cos(), 3.0 * a.sin(), 2.0 + 0.05 * c as f64]
+        })
+        .collect()
+}
+
+/// What rank 0 reads of the column's fluid, and the whole state.
+#[derive(Debug)]
+struct FluidReport {
+    solid_fraction: Vec<f64>,
+    particle_velocity: Vec<f64>,
+    momentum_source: Vec<f64>,
+    particle_fluid: (Vec<u64>, Vec<talus::world::ParticleFluid>),
+    state: Option<SimState>,
+}
+
+/// Blows `wind` of exchanges `exchanges` through the column, 2 ms each.
+fn blow(c: &mut Component, exchanges: std::ops::Range<usize>) -> FluidReport {
+    let u = c.variable("fluid.velocity").unwrap();
+    let cells = c.fluid_grid().unwrap().len();
+    for k in exchanges {
+        c.set_real_vector(u, &wind(cells, k)).unwrap();
+        c.do_step(k as f64 * 0.002, 0.002).unwrap();
+    }
+    FluidReport {
+        solid_fraction: vector(c, "fluid.solid_fraction"),
+        particle_velocity: vector(c, "fluid.particle_velocity"),
+        momentum_source: vector(c, "fluid.momentum_source"),
+        particle_fluid: c.particle_fluid().unwrap(),
+        state: c.simulation().unwrap().whole_snapshot(),
+    }
+}
+
+/// `a` (rank 0 on ranks) is `b` (one process): particles, fields, each
+/// particle's drag, shares and drag of the state to the bit; momentum sources and
+/// the state's impulses to 1e-12 of the largest.
+fn assert_same_fluid(a: &FluidReport, b: &FluidReport) {
+    let (sa, sb) = (a.state.as_ref().unwrap(), b.state.as_ref().unwrap());
+    assert_eq!(sa.steps, sb.steps);
+    assert!(particle_rows(sa) == particle_rows(sb), "particles");
+    assert!(a.solid_fraction == b.solid_fraction, "solid fraction");
+    assert!(
+        a.particle_velocity == b.particle_velocity,
+        "particle velocity"
+    );
+    assert!(
+        a.particle_fluid == b.particle_fluid,
+        "each particle's fluid"
+    );
+    let (fa, fb) = (sa.fluid.as_ref().unwrap(), sb.fluid.as_ref().unwrap());
+    assert!(fa.shares == fb.shares && fa.exchange.drag == fb.exchange.drag);
+    let flat = |v: &[nalgebra::Vector3<f64>]| v.iter().flat_map(|x| x.iter().copied()).collect();
+    for (name, x, y) in [
+        ("momentum source", &a.momentum_source, &b.momentum_source),
+        (
+            "impulse",
+            &flat(&fa.exchange.impulse),
+            &flat(&fb.exchange.impulse),
+        ),
+    ] {
+        let scale = y.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        assert!(scale > 0.0, "{name}: some drag");
+        for (u, v) in x.iter().zip(y) {
+            assert!((u - v).abs() <= 1e-12 * scale, "{name}: {u} against {v}");
+        }
+    }
+}
+
+#[test]
+fn a_coupled_fluid_on_two_and_three_ranks_is_the_fluid_of_one_process() {
+    let run = |c: &mut Component| {
+        start(c);
+        blow(c, 0..8)
+    };
+    let one = on_ranks(0, COLUMN, run).remove(0);
+    let moved = one
+        .particle_fluid
+        .1
+        .iter()
+        .filter(|f| f.drag.norm() > 0.0)
+        .count();
+    assert_eq!(
+        moved,
+        one.particle_fluid.0.len(),
+        "every particle in the gas"
+    );
+    for ranks in [2, 3] {
+        let reports = on_ranks(ranks, COLUMN, run);
+        assert_same_fluid(&reports[0], &one);
+        // The fields the particles make are the whole run's on every rank.
+        for r in &reports[1..] {
+            assert!(r.solid_fraction == one.solid_fraction);
+        }
+    }
+}
+
+#[test]
+fn a_fluid_state_saved_on_two_ranks_continues_on_three_ranks_and_in_one_process() {
+    let saved = on_ranks(2, COLUMN, |c| {
+        start(c);
+        let report = blow(c, 0..4);
+        let state = c.save_state().unwrap();
+        (c.state_to_bytes(&state), report.momentum_source)
+    });
+    assert_eq!(saved[0].0, saved[1].0);
+    let (bytes, source) = &saved[0];
+    let resumed = |c: &mut Component| {
+        start(c);
+        let state = c.state_from_bytes(bytes).unwrap();
+        c.restore_state(&state).unwrap();
+        (vector(c, "fluid.momentum_source"), blow(c, 4..8))
+    };
+    let through = on_ranks(0, COLUMN, |c| {
+        start(c);
+        blow(c, 0..8)
+    })
+    .remove(0);
+    let scale = source.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    for ranks in [0, 3] {
+        let (restored_source, report) = &on_ranks(ranks, COLUMN, resumed)[0];
+        // Restored, rank 0 reads the source of the exchange before the save.
+        for (u, v) in restored_source.iter().zip(source) {
+            assert!(
+                (u - v).abs() <= 1e-12 * scale,
+                "restored source {u} against {v}"
+            );
+        }
+        assert_same_fluid(report, &through);
+    }
 }

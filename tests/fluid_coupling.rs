@@ -518,6 +518,45 @@ update_interval = 5
     );
 }
 
+/// The coupled scene of the face tests: spheres and dodecahedra in a box under
+/// an upward gas flow, shares every 5 steps.
+fn column_scene() -> Scene {
+    Scene::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/scenes/fluid_column.toml"))
+        .unwrap()
+}
+
+/// Particles removed between two updates of the shares: the others keep their
+/// drag, slip and voidage (their rows of the shares go by id, not index), and the
+/// state saved then restores.
+#[test]
+fn removed_particles_leave_the_others_their_fluid() {
+    let mut sim = Simulation::new(&column_scene());
+    for _ in 0..53 {
+        sim.step();
+    }
+    let (ids, before) = sim.whole_particle_fluid().unwrap();
+    let removed = sim.remove_particles(|w, i| w.particles.id[i] % 3 == 1);
+    assert!(removed > 40, "{removed}");
+    let (kept, after) = sim.whole_particle_fluid().unwrap();
+    let expected: Vec<_> = ids
+        .iter()
+        .zip(&before)
+        .filter(|(id, _)| *id % 3 != 1)
+        .collect();
+    assert_eq!(kept.len(), expected.len());
+    assert!(
+        after.iter().all(|f| f.voidage < 1.0),
+        "every particle in the gas"
+    );
+    for ((id, f), (k, g)) in expected.iter().zip(kept.iter().zip(&after)) {
+        assert_eq!((*id, *f), (k, g));
+    }
+    let state = sim.snapshot();
+    let mut restored = Simulation::new(&column_scene());
+    restored.restore(&state).unwrap();
+    assert_eq!(restored.whole_particle_fluid().unwrap().1, after);
+}
+
 /// The scene of glass beads in a box under an upward water flow, with `fluid` as the
 /// `[fluid]` section's keys (after a structured grid's origin and cell size unless
 /// they name a `grid`).

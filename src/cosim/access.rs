@@ -161,7 +161,10 @@ impl Component {
             }
             Role::SolidFraction => fluid.map_or(0.0, |f| f.solid_fraction[k]),
             Role::ParticleVelocity => fluid.map_or(0.0, |f| f.particle_velocity[k / 3][k % 3]),
-            Role::MomentumSource => fluid.map_or(0.0, |f| f.momentum_source(k / 3)[k % 3]),
+            Role::MomentumSource => match self.gathered.as_ref().map(|g| &g.momentum_source) {
+                Some(Some(source)) => source[k / 3][k % 3],
+                _ => fluid.map_or(0.0, |f| f.momentum_source(k / 3)[k % 3]),
+            },
             Role::Scene | Role::OutputDir | Role::Threads | Role::Particles | Role::Contacts => {
                 unreachable!("not a real variable")
             }

@@ -620,12 +620,20 @@ impl Component {
 
     /// Each particle's id and what the fluid does to it (drag of the last force
     /// evaluation, slip, local voidage: [`ParticleFluid`]), in the simulation's
-    /// order; before initialisation the scene's particles at rest in the start
-    /// fields (no drag yet). Particles come and go, so this crosses the faces as
+    /// order (on ranks the whole run's, in id order, on rank 0); before
+    /// initialisation the scene's particles at rest in the start fields (no drag
+    /// yet). Particles come and go, so this crosses the faces as
     /// whole lists (C API, zenoh), not as variables.
     pub fn particle_fluid(&self) -> Result<(Vec<u64>, Vec<ParticleFluid>), CosimError> {
         let world = self.world();
         let fluid = world.fluid.as_ref().ok_or(CosimError::NoFluid)?;
+        if let Some(whole) = self
+            .gathered
+            .as_ref()
+            .and_then(|g| g.particle_fluid.clone())
+        {
+            return Ok(whole);
+        }
         let p = &world.particles;
         let n = p.owned();
         Ok((

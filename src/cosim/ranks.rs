@@ -5,8 +5,10 @@
 //!
 //! - **Outputs**: the walls' forces and torques are the whole run's on every rank
 //!   (see [`crate::scene::ranks`]); the figures of the particles are the whole run's
-//!   sums. What needs the whole world (facet forces, the drum's angle of repose, the
-//!   bed's figures) is gathered on rank 0 after each change of the state: rank 0
+//!   sums; a coupled fluid's solid fraction and mean particle velocity are the whole
+//!   run's on every rank. What needs the whole world (facet forces, the drum's
+//!   angle of repose, the bed's figures, a fluid's momentum source and what it does
+//!   to each particle) is gathered on rank 0 after each change of the state: rank 0
 //!   answers the host; the other ranks' answers are never sent.
 //! - **States**: a saved state is the whole run's, gathered on rank 0 and sent back
 //!   to every rank, the same bytes one process saves; a restore (of a state saved
@@ -21,8 +23,8 @@ use super::component::Component;
 use crate::Real;
 use crate::analysis::packing::{BedFigures, bed_figures};
 use crate::engine::exchange::{Ranks, broadcast_bytes};
-use crate::scene::ranks::{RanksError, check_on_ranks};
 use crate::scene::{Scene, ShareState, SimState, Simulation, StateReader, StateWriter};
+use crate::world::ParticleFluid;
 
 /// What rank 0 reads of the whole run that no rank's share holds, gathered after
 /// every change of the state.
@@ -34,19 +36,22 @@ pub(super) struct Gathered {
     pub(super) angle_of_repose: Real,
     /// The bed's figures (a scene with a bed).
     pub(super) bed: Option<BedFigures>,
+    /// A coupled fluid's momentum source per cell.
+    pub(super) momentum_source: Option<Vec<Vector3<Real>>>,
+    /// Each particle's id and what a coupled fluid does to it, in id order.
+    pub(super) particle_fluid: Option<(Vec<u64>, Vec<ParticleFluid>)>,
 }
 
 impl Component {
     /// Loads the scene at `path` (relative to `base_dir`) as this rank's component
     /// of a run on `ranks`: every rank calls it, and then makes the same calls in
-    /// the same order. An error when the scene needs what ranks do not run.
+    /// the same order.
     pub fn instantiate_on_ranks(
         base_dir: &std::path::Path,
         path: &str,
         ranks: Box<dyn Ranks>,
     ) -> Result<Self, CosimError> {
         let mut component = Component::instantiate(base_dir, path)?;
-        check_on_ranks(&component.scene).map_err(|e| CosimError::Ranks(e.to_string()))?;
         component.ranks = Some(ranks);
         Ok(component)
     }
@@ -117,16 +122,22 @@ impl Component {
             .as_ref()
             .expect("a running component has a simulation");
         let scene = &self.scene;
+        let momentum_source = sim.whole_momentum_source();
+        let particle_fluid = sim.whole_particle_fluid();
         self.gathered = (|| {
             if scene.drum.is_none() && scene.bed.is_none() {
                 let facet_forces = sim.whole_facet_forces()?;
                 return Some(Gathered {
                     facet_forces,
+                    momentum_source,
+                    particle_fluid,
                     ..Gathered::default()
                 });
             }
             let world = sim.whole_world()?;
             Some(Gathered {
+                momentum_source,
+                particle_fluid,
                 facet_forces: world.walls.iter().map(|w| w.facet_force.clone()).collect(),
                 angle_of_repose: scene
                     .drum
@@ -147,7 +158,6 @@ pub(super) fn new_simulation(
     exchange: Option<Box<dyn Ranks>>,
     state: Option<&SimState>,
 ) -> Result<Simulation, CosimError> {
-    let ranked = |e: RanksError| CosimError::Ranks(e.to_string());
     match (exchange, state) {
         (None, None) => Ok(Simulation::new(scene)),
         (None, Some(state)) => {
@@ -155,9 +165,7 @@ pub(super) fn new_simulation(
             sim.restore(state)?;
             Ok(sim)
         }
-        (Some(exchange), None) => Simulation::on_ranks(scene, exchange).map_err(ranked),
-        (Some(exchange), Some(state)) => {
-            Simulation::on_ranks_from(scene, exchange, state).map_err(ranked)
-        }
+        (Some(exchange), None) => Ok(Simulation::on_ranks(scene, exchange)),
+        (Some(exchange), Some(state)) => Ok(Simulation::on_ranks_from(scene, exchange, state)?),
     }
 }

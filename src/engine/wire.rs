@@ -8,6 +8,7 @@ use nalgebra::{Point3, UnitQuaternion, Vector3};
 use crate::Real;
 use crate::contact::TangentialHistory;
 use crate::engine::backend::ContactHistory;
+use crate::world::{CellContribution, ParticleFluid, ShareRow};
 
 /// A value that travels between ranks.
 pub trait Message: Sized + Send + 'static {
@@ -198,6 +199,63 @@ impl Message for ContactHistory {
     }
 }
 
+impl<T: Message> Message for Option<T> {
+    fn encode(&self, out: &mut Vec<u64>) {
+        out.push(u64::from(self.is_some()));
+        if let Some(m) = self {
+            m.encode(out);
+        }
+    }
+    fn decode(words: &mut Words<'_>) -> Self {
+        (words.next_word() != 0).then(|| T::decode(words))
+    }
+}
+
+impl Message for ShareRow {
+    fn encode(&self, out: &mut Vec<u64>) {
+        out.push(self.cells.len() as u64);
+        out.extend(self.cells.iter().map(|&c| u64::from(c)));
+        self.volumes.iter().for_each(|v| v.encode(out));
+    }
+    fn decode(words: &mut Words<'_>) -> Self {
+        let n = words.next_word() as usize;
+        let cells = (0..n).map(|_| words.next_word() as u32).collect();
+        let volumes = (0..n).map(|_| Real::decode(words)).collect();
+        ShareRow { cells, volumes }
+    }
+}
+
+impl Message for CellContribution {
+    fn encode(&self, out: &mut Vec<u64>) {
+        out.extend([u64::from(self.cell), self.id]);
+        self.volume.encode(out);
+        self.momentum.encode(out);
+    }
+    fn decode(words: &mut Words<'_>) -> Self {
+        CellContribution {
+            cell: words.next_word() as u32,
+            id: words.next_word(),
+            volume: Real::decode(words),
+            momentum: Vector3::decode(words),
+        }
+    }
+}
+
+impl Message for ParticleFluid {
+    fn encode(&self, out: &mut Vec<u64>) {
+        self.drag.encode(out);
+        self.slip.encode(out);
+        self.voidage.encode(out);
+    }
+    fn decode(words: &mut Words<'_>) -> Self {
+        ParticleFluid {
+            drag: Vector3::decode(words),
+            slip: Vector3::decode(words),
+            voidage: Real::decode(words),
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -233,5 +291,33 @@ mod tests {
             q.coords.map(Real::to_bits)
         );
         assert!(back[0].1.1 && !back[1].1.1);
+    }
+
+    /// The fluid's messages: a row or none, a cell's contribution, what the fluid
+    /// does to a particle.
+    #[test]
+    fn fluid_messages_come_back_to_the_bit() {
+        let row = ShareRow {
+            cells: vec![0, 7, u32::MAX],
+            volumes: vec![1e-9, -0.0, 5e-324],
+        };
+        let rows = vec![Some(row.clone()), None, Some(ShareRow::default())];
+        assert_eq!(decode_list::<Option<ShareRow>>(&encode_list(&rows)), rows);
+        let c = CellContribution {
+            cell: 12,
+            id: u64::MAX,
+            volume: 1.0 / 3.0,
+            momentum: Vector3::new(-1e-300, 0.0, 2.0),
+        };
+        let f = ParticleFluid {
+            drag: Vector3::new(1.0, -2.0, 1e-20),
+            slip: Vector3::new(0.5, 0.25, -0.125),
+            voidage: 0.4,
+        };
+        let list = vec![(c, f)];
+        assert_eq!(
+            decode_list::<(CellContribution, ParticleFluid)>(&encode_list(&list)),
+            list
+        );
     }
 }

@@ -3,6 +3,7 @@
 use nalgebra::Vector3;
 
 use super::Simulation;
+use super::fluid_ranks::update_fluid_on_ranks;
 use super::spec::UpdateInterval;
 use crate::Real;
 use crate::world::FluidField;
@@ -43,13 +44,17 @@ impl Simulation {
     /// fractions, mean particle velocities and exchange weights). The simulation
     /// does it every `update_interval` steps, or at each communication step
     /// ([`Self::start_communication_step`]); a coupled code may ask for it at its
-    /// own exchange.
+    /// own exchange. On ranks collective, with one process's bits.
     pub fn update_fluid(&mut self) {
         let w = &mut self.world;
-        if let Some(fluid) = w.fluid.as_mut() {
-            fluid.update(&w.particles, &w.body_types);
-            self.backend.fluid_changed(&self.world);
+        let Some(fluid) = w.fluid.as_mut() else {
+            return;
+        };
+        match self.backend.share() {
+            Some(share) => update_fluid_on_ranks(share, w),
+            None => fluid.update(&w.particles, &w.body_types),
         }
+        self.backend.fluid_changed(&self.world);
     }
 
     /// Sets the fluid's velocity in every cell (flat order of the grid); on error
@@ -64,10 +69,15 @@ impl Simulation {
     }
 
     /// The mean force per cell the particles put on the fluid since the last call
-    /// (the drag they received, with the opposite sign; N).
+    /// (the drag they received, with the opposite sign; N). On ranks collective:
+    /// the whole run's on rank 0, an empty list on the others.
     pub fn take_momentum_source(&mut self) -> Result<Vec<Vector3<Real>>, FluidError> {
-        let fluid = self.world.fluid.as_mut().ok_or(FluidError::NoFluid)?;
-        Ok(fluid.take_momentum_source())
+        if self.world.fluid.is_none() {
+            return Err(FluidError::NoFluid);
+        }
+        let source = self.whole_momentum_source().unwrap_or_default();
+        self.restart_fluid_exchange();
+        Ok(source)
     }
 
     /// What a coupled run does at the start of each communication step, once the

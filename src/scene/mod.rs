@@ -15,6 +15,7 @@ pub mod energy_ledger;
 mod error;
 mod fluid;
 mod fluid_coupling;
+mod fluid_ranks;
 mod locate;
 mod plan;
 pub mod poses;

@@ -10,10 +10,10 @@ use nalgebra::Vector3;
 use super::Scene;
 use super::Simulation;
 use super::energy_ledger::HeldEnergy;
-use super::ranks::{
-    REBALANCE_ABOVE, RanksError, check_on_ranks, seeds_of, spread_facet_forces, sum_facet_forces,
-};
+use super::fluid_ranks::{keep_fluid_share, whole_exchange};
+use super::ranks::{REBALANCE_ABOVE, seeds_of, spread_facet_forces, sum_facet_forces};
 use super::state::SimState;
+use super::state_bytes::StateError;
 use crate::Real;
 use crate::engine::decomposition::Decomposition;
 use crate::engine::exchange::Exchange;
@@ -70,7 +70,8 @@ impl Simulation {
     /// The whole run's state of every rank's `share` (taken at the same step): in
     /// one process the share itself; on ranks (collective) gathered on rank 0 (the
     /// state one process saves: particles in id order with their forces, history
-    /// sorted by key), and `None` on the others.
+    /// sorted by key, a fluid's shares and drag in id order with the impulse
+    /// summed), and `None` on the others.
     pub fn gather_state(&self, share: ShareState) -> Option<SimState> {
         let ShareState { mut state } = share;
         let Some(ranks) = self.backend.share() else {
@@ -83,8 +84,17 @@ impl Simulation {
         let particles = gather_to_first(ranks, &particles);
         let histories = gather_to_first(ranks, &[std::mem::take(&mut state.history)]);
         let facets = sum_facet_forces(ranks, state.walls.iter().map(|w| &w.facet_force));
+        let ids = &p.id[..p.owned()];
+        let exchange = state
+            .fluid
+            .as_ref()
+            .map(|f| whole_exchange(ranks, ids, &f.shares, &f.exchange));
         if ranks.rank() != 0 {
             return None;
+        }
+        if let (Some(f), Some(Some((shares, exchange)))) = (state.fluid.as_mut(), exchange) {
+            f.shares = shares;
+            f.exchange = exchange;
         }
         state.particles = saved_particles(particles.into_iter().flatten().collect());
         let mut history = ContactHistory::default();
@@ -113,8 +123,7 @@ impl Simulation {
         scene: &Scene,
         exchange: E,
         state: &SimState,
-    ) -> Result<Self, RanksError> {
-        check_on_ranks(scene)?;
+    ) -> Result<Self, StateError> {
         let params = scene.step_params();
         let mut sim = Simulation::assemble(
             scene,
@@ -134,6 +143,10 @@ impl Simulation {
             Default::default(),
         )
         .rebalance_above(REBALANCE_ABOVE);
+        if let Some(fluid) = &state.fluid {
+            let rank = stepper.exchange().rank();
+            keep_fluid_share(&mut world, fluid, &state.particles.id, rank);
+        }
         sim.world = world;
         sim.backend = Box::new(stepper);
         sim.reduce_over_ranks(HeldEnergy::default(), 0.0);

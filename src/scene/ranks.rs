@@ -22,7 +22,7 @@ use nalgebra::{Point3, Vector3};
 use super::Scene;
 use super::Simulation;
 use super::energy_ledger::{EnergyLedger, HeldEnergy};
-use super::state_bytes::StateError;
+use super::fluid_ranks::whole_fluid;
 use crate::Real;
 use crate::analysis::packing::{Bed, bed_height_of, measured_from};
 use crate::engine::decomposition::Decomposition;
@@ -99,47 +99,14 @@ pub(super) struct WholeRun {
     pub figures: RunFigures,
 }
 
-/// Why a scene cannot run on ranks.
-#[derive(Debug, thiserror::Error)]
-pub enum RanksError {
-    /// The scene needs what the ranks do not provide yet.
-    #[error("{file}: {what} does not run on MPI ranks yet; run it in one process")]
-    Unsupported { file: String, what: &'static str },
-    /// The state to continue from does not fit the scene.
-    #[error(transparent)]
-    State(#[from] StateError),
-}
-
-/// Whether the ranks can run `scene`: an error names what it needs that they do
-/// not provide yet.
-pub fn check_on_ranks(scene: &Scene) -> Result<(), RanksError> {
-    match unsupported_on_ranks(scene) {
-        Some(what) => Err(RanksError::Unsupported {
-            file: scene.file.display().to_string(),
-            what,
-        }),
-        None => Ok(()),
-    }
-}
-
-fn unsupported_on_ranks(scene: &Scene) -> Option<&'static str> {
-    scene
-        .spec
-        .fluid
-        .is_some()
-        .then_some("a coupled fluid ([fluid])")
-}
-
 impl Simulation {
     /// Starts a scene at time 0 on the ranks of `exchange` (every rank calls it
     /// with the same scene): every rank inserts what is due at 0 into the whole
     /// world, as one process does, bisects the space at the particles (at the
-    /// walls when there are none yet) and keeps its share.
-    pub fn on_ranks<E: Exchange + Send + fmt::Debug + 'static>(
-        scene: &Scene,
-        exchange: E,
-    ) -> Result<Self, RanksError> {
-        check_on_ranks(scene)?;
+    /// walls when there are none yet) and keeps its share; then, as one process,
+    /// splits the particles among a coupled fluid's cells and evaluates the first
+    /// forces.
+    pub fn on_ranks<E: Exchange + Send + fmt::Debug + 'static>(scene: &Scene, exchange: E) -> Self {
         let mut world = scene.world.clone();
         let mut inlets = scene.inlets.clone();
         let mut next_id = scene.next_id;
@@ -148,21 +115,23 @@ impl Simulation {
         }
         let seeds = seeds_of(&world);
         let layout = Decomposition::bisect(&seeds, &vec![1.0; seeds.len()], exchange.size());
-        let stepper = RankStepper::new(
+        let stepper = RankStepper::restored(
             exchange,
             layout,
             scene.step_params(),
             &mut world,
             &ContactHistory::default(),
-            scene.dt,
+            StepStats::default(),
         )
         .rebalance_above(REBALANCE_ABOVE);
         let mut sim = Simulation::assemble(scene, world, Box::new(stepper));
         sim.inlets = inlets;
         sim.next_id = next_id;
+        sim.update_fluid();
+        sim.backend.initialise(&mut sim.world, sim.dt);
         sim.reduce_over_ranks(HeldEnergy::default(), 0.0);
         sim.energy = EnergyLedger::new(&sim.held_energy());
-        Ok(sim)
+        sim
     }
 
     /// This rank and the number of ranks, on ranks.
@@ -179,8 +148,8 @@ impl Simulation {
     }
 
     /// The whole world: this one in one process; on ranks (collective) the owned
-    /// particles of every rank in id order, with the walls' facet forces summed, on
-    /// rank 0, and `None` on the others.
+    /// particles of every rank in id order, with the walls' facet forces summed and
+    /// a coupled fluid as one process holds it, on rank 0, and `None` on the others.
     pub fn whole_world(&self) -> Option<Cow<'_, World>> {
         let Some(share) = self.backend.share() else {
             return Some(Cow::Borrowed(&self.world));
@@ -190,11 +159,13 @@ impl Simulation {
             (0..p.owned()).map(|i| ParticleRecord::of(p, i)).collect();
         let records = gather_to_first(share, &records);
         let total = sum_facet_forces(share, self.world.walls.iter().map(|w| &w.facet_force));
+        let fluid = whole_fluid(share, &self.world);
         if share.rank() != 0 {
             return None;
         }
         let mut whole = world_of(&self.world, records.into_iter().flatten().collect());
         spread_facet_forces(&total, whole.walls.iter_mut().map(|w| &mut w.facet_force));
+        whole.fluid = fluid;
         Some(Cow::Owned(whole))
     }
 
@@ -368,7 +339,7 @@ impl Shares {
 }
 
 /// A world like `like` holding `records`' particles in id order (the order of one
-/// process, whose ids ascend with insertion).
+/// process, whose ids ascend with insertion), without a fluid.
 fn world_of(like: &World, mut records: Vec<ParticleRecord>) -> World {
     records.sort_unstable_by_key(|r| r.id);
     let mut particles = Particles::default();
@@ -383,7 +354,7 @@ fn world_of(like: &World, mut records: Vec<ParticleRecord>) -> World {
         walls: like.walls.clone(),
         gravity: like.gravity,
         time: like.time,
-        fluid: like.fluid.clone(),
+        fluid: None,
     }
 }
 
@@ -439,7 +410,13 @@ pub(super) fn sum_facet_forces<'a>(
     walls: impl Iterator<Item = &'a Vec<Vector3<Real>>>,
 ) -> Vec<Vector3<Real>> {
     let facets: Vec<Vector3<Real>> = walls.flatten().copied().collect();
-    let mut ranks = gather_to_first(share, &facets).into_iter();
+    sum_on_first(share, &facets)
+}
+
+/// Every rank's `mine` (as long on every rank) summed element by element in rank
+/// order, on rank 0 (collective; empty on the others).
+pub(super) fn sum_on_first(share: &dyn Share, mine: &[Vector3<Real>]) -> Vec<Vector3<Real>> {
+    let mut ranks = gather_to_first(share, mine).into_iter();
     let first = ranks.next().unwrap_or_default();
     ranks.fold(first, |mut total, other| {
         for (t, o) in total.iter_mut().zip(&other) {

@@ -11,17 +11,31 @@ use crate::geometry::Pose;
 
 /// Per particle, the cells it reaches and its volume in each.
 ///
+/// A row belongs to a particle id, not to an index: it stays the particle's when
+/// others are removed or the particle changes rank, until the shares are computed
+/// again. A particle inserted since has no row.
+///
 /// # Invariant
-/// `starts` has one entry per particle plus one; particle `i`'s cells are
-/// `cells[starts[i]..starts[i + 1]]`, ascending, each with a positive volume; `ids`
-/// holds the id of the particle each row was computed for (a row whose id no longer
-/// matches the particle at that index is stale and not used).
+/// `starts` has one entry per row plus one; row `r`'s cells are
+/// `cells[starts[r]..starts[r + 1]]`, ascending, each with a positive volume; `ids`
+/// holds the particle id of each row, no id twice; `by_id` holds `(id, row)` for
+/// every row, sorted by id.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct CellShares {
     starts: Vec<u32>,
     cells: Vec<u32>,
     volumes: Vec<Real>,
     ids: Vec<u64>,
+    by_id: Vec<(u64, u32)>,
+}
+
+/// One particle's row of [`CellShares`]: the cells it reaches and its volume in each.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ShareRow {
+    /// Cells, ascending.
+    pub cells: Vec<u32>,
+    /// The particle's volume in each.
+    pub volumes: Vec<Real>,
 }
 
 impl CellShares {
@@ -41,18 +55,77 @@ impl CellShares {
             .collect();
         let mut shares = CellShares {
             starts: Vec::with_capacity(n + 1),
-            ids: particles.id[..n].to_vec(),
             ..Default::default()
         };
         shares.starts.push(0);
-        for row in rows {
+        for (row, &id) in rows.into_iter().zip(&particles.id[..n]) {
             for (c, v) in row {
                 shares.cells.push(c);
                 shares.volumes.push(v);
             }
             shares.starts.push(shares.cells.len() as u32);
+            shares.ids.push(id);
         }
+        shares.index();
         shares
+    }
+
+    /// Shares of the rows `rows` (particle id and row; no id twice), in that order.
+    pub fn from_rows<'a>(rows: impl IntoIterator<Item = (u64, &'a ShareRow)>) -> Self {
+        let mut shares = CellShares {
+            starts: vec![0],
+            ..Default::default()
+        };
+        for (id, row) in rows {
+            shares.cells.extend_from_slice(&row.cells);
+            shares.volumes.extend_from_slice(&row.volumes);
+            shares.starts.push(shares.cells.len() as u32);
+            shares.ids.push(id);
+        }
+        shares.index();
+        shares
+    }
+
+    /// The row of particle `id`, if it has one.
+    pub fn row_of(&self, id: u64) -> Option<ShareRow> {
+        let r = self.position_of(id)?;
+        let (cells, volumes) = self.row(r);
+        Some(ShareRow {
+            cells: cells.to_vec(),
+            volumes: volumes.to_vec(),
+        })
+    }
+
+    /// Keeps the rows of the particles `ids` (in that order) that have one and
+    /// appends `arrived` (rows of particles new to these shares).
+    pub fn keep(&self, ids: &[u64], arrived: &[(u64, ShareRow)]) -> Self {
+        let kept: Vec<(u64, ShareRow)> = ids
+            .iter()
+            .filter_map(|&id| Some((id, self.row_of(id)?)))
+            .collect();
+        Self::from_rows(kept.iter().chain(arrived).map(|(id, row)| (*id, row)))
+    }
+
+    /// Sorts the id index; ids must be unique.
+    fn index(&mut self) {
+        self.by_id = self
+            .ids
+            .iter()
+            .enumerate()
+            .map(|(r, &id)| (id, r as u32))
+            .collect();
+        self.by_id.sort_unstable();
+        debug_assert!(self.by_id.windows(2).all(|w| w[0].0 < w[1].0));
+    }
+
+    fn position_of(&self, id: u64) -> Option<usize> {
+        let k = self.by_id.binary_search_by_key(&id, |e| e.0).ok()?;
+        Some(self.by_id[k].1 as usize)
+    }
+
+    fn row(&self, r: usize) -> (&[u32], &[Real]) {
+        let span = self.starts[r] as usize..self.starts[r + 1] as usize;
+        (&self.cells[span.clone()], &self.volumes[span])
     }
 
     /// Rebuilds shares from their parts (a saved state), checking the invariant
@@ -79,12 +152,26 @@ impl CellShares {
         if !ok {
             return Err("fluid cell shares are inconsistent".into());
         }
-        Ok(CellShares {
+        let mut shares = CellShares {
             starts,
             cells,
             volumes,
             ids,
-        })
+            by_id: Vec::new(),
+        };
+        shares.index_checked()?;
+        Ok(shares)
+    }
+
+    /// [`Self::index`], refusing an id held twice.
+    fn index_checked(&mut self) -> Result<(), String> {
+        let mut sorted = self.ids.clone();
+        sorted.sort_unstable();
+        if let Some(w) = sorted.windows(2).find(|w| w[0] == w[1]) {
+            return Err(format!("fluid cell shares hold particle {} twice", w[0]));
+        }
+        self.index();
+        Ok(())
     }
 
     /// The parts (for a saved state): starts, cells, volumes, ids.
@@ -92,14 +179,15 @@ impl CellShares {
         (&self.starts, &self.cells, &self.volumes, &self.ids)
     }
 
-    /// Particle `i`'s cells and its volume in each, if its row is up to date for the
-    /// particle of `id`.
+    /// The cells of particle `id` (at index `i` of its world) and its volume in
+    /// each, if it has a row. Row `i` is looked at first: it is the particle's
+    /// unless particles came or went since the shares were computed.
     pub fn of(&self, i: usize, id: u64) -> Option<(&[u32], &[Real])> {
-        if self.ids.get(i) != Some(&id) {
-            return None;
-        }
-        let r = self.starts[i] as usize..self.starts[i + 1] as usize;
-        Some((&self.cells[r.clone()], &self.volumes[r]))
+        let r = match self.ids.get(i) {
+            Some(&at) if at == id => i,
+            _ => self.position_of(id)?,
+        };
+        Some(self.row(r))
     }
 
     /// Rows (particles) held.

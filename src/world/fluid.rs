@@ -33,6 +33,35 @@ pub struct MomentumExchange {
     pub elapsed: Real,
 }
 
+impl MomentumExchange {
+    /// The mean force the particles put on cell `c` of the fluid since the sums were
+    /// last started (minus the drag they received there, averaged over the time);
+    /// zero when no time passed.
+    pub fn source(&self, c: usize) -> Vector3<Real> {
+        let t = self.elapsed;
+        if t > 0.0 {
+            -self.impulse[c] / t
+        } else {
+            Vector3::zeros()
+        }
+    }
+}
+
+/// A particle's volume in one cell and the momentum it brings there (its velocity
+/// times that volume): what the cell's solid fraction and mean particle velocity
+/// are summed from.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CellContribution {
+    /// The cell's flat index.
+    pub cell: u32,
+    /// The particle's id.
+    pub id: u64,
+    /// Its volume in the cell, m³.
+    pub volume: Real,
+    /// Its velocity times that volume, m⁴/s.
+    pub momentum: Vector3<Real>,
+}
+
 /// The fluid field of a coupled scene.
 ///
 /// # Invariant
@@ -121,29 +150,60 @@ impl FluidField {
     }
 
     /// Splits every owned particle's volume among the cells again: the shares, the
-    /// solid fractions and the mean particle velocities (summed in particle order:
-    /// the same bits on any thread count).
+    /// solid fractions and the mean particle velocities (each cell's sums in
+    /// particle order: the same bits on any thread count).
     pub fn update(&mut self, particles: &Particles, types: &[BodyType]) {
         self.shares = CellShares::compute(&self.grid, particles, types);
-        let mut solid = vec![0.0; self.grid.len()];
+        let mut volume = vec![0.0; self.grid.len()];
         let mut momentum = vec![Vector3::zeros(); self.grid.len()];
+        for c in self.contributions(particles) {
+            volume[c.cell as usize] += c.volume;
+            momentum[c.cell as usize] += c.momentum;
+        }
+        self.set_cell_means(0, &volume, &momentum);
+    }
+
+    /// What each owned particle with a row of the shares brings to each of its
+    /// cells, in particle order, then cell order.
+    pub fn contributions(&self, particles: &Particles) -> Vec<CellContribution> {
+        let mut out = Vec::new();
         for i in 0..particles.owned() {
-            let (cells, volumes) = self.shares.of(i, particles.id[i]).expect("just computed");
-            for (&c, &v) in cells.iter().zip(volumes) {
-                solid[c as usize] += v;
-                momentum[c as usize] += particles.velocity[i] * v;
+            let id = particles.id[i];
+            let Some((cells, volumes)) = self.shares.of(i, id) else {
+                continue;
+            };
+            for (&cell, &volume) in cells.iter().zip(volumes) {
+                out.push(CellContribution {
+                    cell,
+                    id,
+                    volume,
+                    momentum: particles.velocity[i] * volume,
+                });
             }
         }
-        for (c, ((phi, u), (s, m))) in self
-            .solid_fraction
-            .iter_mut()
-            .zip(&mut self.particle_velocity)
-            .zip(solid.iter().zip(&momentum))
-            .enumerate()
-        {
-            *phi = s / self.grid.cell_volume(c);
-            *u = if *s > 0.0 { m / *s } else { Vector3::zeros() };
+        out
+    }
+
+    /// Sets the solid fraction and the mean particle velocity of the cells from
+    /// `first` on, from the sums of the particles' volumes and momenta in them.
+    pub fn set_cell_means(&mut self, first: usize, volume: &[Real], momentum: &[Vector3<Real>]) {
+        for (k, (s, m)) in volume.iter().zip(momentum).enumerate() {
+            let c = first + k;
+            self.solid_fraction[c] = s / self.grid.cell_volume(c);
+            self.particle_velocity[c] = if *s > 0.0 { m / *s } else { Vector3::zeros() };
         }
+    }
+
+    /// Forgets what it kept of the owned particles that were removed (`removed`: by
+    /// their index before; `particles`: the rest, in their order): the others keep
+    /// their drag and their rows of the shares.
+    pub fn particles_removed(&mut self, removed: &[bool], particles: &Particles) {
+        let mut i = 0;
+        self.exchange.drag.retain(|_| {
+            i += 1;
+            !removed.get(i - 1).copied().unwrap_or(false)
+        });
+        self.shares = self.shares.keep(&particles.id[..particles.owned()], &[]);
     }
 
     /// Visits each cell particle `i` (of `id`, at `position`) lies in with its weight
@@ -192,29 +252,14 @@ impl FluidField {
     }
 
     /// The mean force the particles put on cell `c` of the fluid since the sums were
-    /// last started (minus the drag they received there, averaged over the time);
-    /// zero when no time passed.
+    /// last started ([`MomentumExchange::source`]).
     pub fn momentum_source(&self, c: usize) -> Vector3<Real> {
-        let t = self.exchange.elapsed;
-        if t > 0.0 {
-            -self.exchange.impulse[c] / t
-        } else {
-            Vector3::zeros()
-        }
+        self.exchange.source(c)
     }
 
     /// Starts the sums of the exchange again.
     pub fn restart_exchange(&mut self) {
         self.exchange.impulse.fill(Vector3::zeros());
         self.exchange.elapsed = 0.0;
-    }
-
-    /// The [`Self::momentum_source`] of every cell, and starts the sums again.
-    pub fn take_momentum_source(&mut self) -> Vec<Vector3<Real>> {
-        let out = (0..self.grid.len())
-            .map(|c| self.momentum_source(c))
-            .collect();
-        self.restart_exchange();
-        out
     }
 }

@@ -12,8 +12,10 @@ use std::ops::Range;
 
 use nalgebra::Vector3;
 
-pub use cell_shares::CellShares;
-pub use fluid::{DragModel, FluidField, LocalFluid, MomentumExchange, ParticleFluid};
+pub use cell_shares::{CellShares, ShareRow};
+pub use fluid::{
+    CellContribution, DragModel, FluidField, LocalFluid, MomentumExchange, ParticleFluid,
+};
 pub use inlet::{Inlet, Obstacle, PLACEMENT_ATTEMPTS, PlacedParticle, is_free, random_orientation};
 pub use motion::{DriveInput, MotionKey, WallMotion, WallVelocity, advance_pose};
 pub use particles::Particles;

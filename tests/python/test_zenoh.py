@@ -1,9 +1,9 @@
 """The zenoh node (`talus serve`) driven by the Python client: forces equal to the
 component's, published steps in order, bad requests answered, disconnects, two
-clients, and a clean stop on SIGTERM. Every drum test runs against one process and
-against `mpirun -np 2 talus serve` (rank 0 the node, both ranks stepping): the
-client cannot tell them apart, except that wall forces summed over two ranks agree
-with one process's to round-off. Loopback only, one port per test."""
+clients, and a clean stop on SIGTERM. Every drum test and the fluid test run
+against one process and against `mpirun -np 2 talus serve` (rank 0 the node, both
+ranks stepping): the client cannot tell them apart, except that wall forces and
+momentum sources summed over two ranks agree with one process's to round-off. Loopback only, one port per test."""
 import ctypes
 import sys
 import threading
@@ -159,8 +159,9 @@ def test_sigterm_stops_the_node_cleanly_with_its_outputs(drum_server, proto_dir)
     assert (drum_server.out / "particles.pvd").is_file()
 
 
-def test_the_fluid_fields_over_zenoh_equal_the_c_apis(tmp_path, proto_dir):
-    server = Server(SCENES["fluid"], tmp_path / "out")
+@pytest.mark.parametrize("ranks", [1, 2], ids=["one-process", "mpirun-np-2"])
+def test_the_fluid_fields_over_zenoh_equal_the_c_apis(tmp_path, proto_dir, ranks):
+    server = Server(SCENES["fluid"], tmp_path / "out", ranks=ranks)
     try:
         with server.client(proto_dir) as client:
             lib = ctypes.CDLL(str(TALUS.with_name("libtalus.so")))
@@ -183,7 +184,13 @@ def test_the_fluid_fields_over_zenoh_equal_the_c_apis(tmp_path, proto_dir):
                 out = (ctypes.c_double * size)()
                 assert lib.talus_get_real(handle, f"fluid.{name}".encode(), out,
                                           ctypes.c_size_t(size)) == 0
-                assert list(getattr(fields, name)) == list(out), name
+                if name == "momentum_source":
+                    # Each rank sums its particles' drag: equal to round-off.
+                    scale = max(abs(x) for x in out)
+                    assert all(abs(a - b) <= 1e-12 * scale
+                               for a, b in zip(getattr(fields, name), out)), name
+                else:
+                    assert list(getattr(fields, name)) == list(out), name
             assert sum(fields.momentum_source[2::3]) < 0.0
             assert len(fields.particle_ids) == 0, "per particle only when asked"
             # Per particle: the same bits as the C API's.
@@ -205,4 +212,5 @@ def test_the_fluid_fields_over_zenoh_equal_the_c_apis(tmp_path, proto_dir):
             assert client.fluid().time == t
             lib.talus_free(handle)
     finally:
-        assert server.stop() == 0
+        # Open MPI's mpirun exits with 1 after it forwarded the SIGTERM.
+        assert server.stop() == 0 or ranks > 1

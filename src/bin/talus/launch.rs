@@ -102,11 +102,6 @@ impl Launch {
         }
     }
 
-    /// Whether this is one rank of several processes.
-    pub fn is_rank(&self) -> bool {
-        !matches!(self, Launch::OneProcess)
-    }
-
     /// The number of ranks, on ranks.
     #[cfg_attr(not(feature = "zenoh"), allow(dead_code))]
     pub fn rank_count(&self) -> Option<usize> {
@@ -163,7 +158,7 @@ impl Launch {
                     .ok_or_else(|| anyhow::anyhow!("one simulation per rank"))?;
                 Ok(match state {
                     Some(state) => Simulation::on_ranks_from(scene, exchange, state)?,
-                    None => Simulation::on_ranks(scene, exchange)?,
+                    None => Simulation::on_ranks(scene, exchange),
                 })
             }
         }

@@ -78,9 +78,6 @@ pub fn run(path: Option<&Path>, options: RunOptions) -> Result<()> {
         );
     }
     let mut launch = Launch::detect()?;
-    if launch.is_rank() {
-        talus::scene::ranks::check_on_ranks(&scene)?;
-    }
     let (pool, threads) = worker_pool_of(options.threads, &scene, launch.local_ranks())?;
     let stop = Arc::new(AtomicBool::new(false));
     {

@@ -17,7 +17,8 @@
 //! pair with one of its particles owned there, computed identically on each; at a
 //! renewal a leaving particle takes the history of its pairs and its wall patches
 //! with it, and what it brings overrides the new rank's copy (a pair of two ghosts
-//! is not evaluated, so that copy may be stale).
+//! is not evaluated, so that copy may be stale). So does its row of a coupled
+//! fluid's cell shares.
 
 use std::collections::BTreeMap;
 use std::ops::Range;
@@ -43,7 +44,7 @@ mod share;
 pub use cost::{PARTICLE_COST, POLYHEDRON_PAIR_COST, particle_costs};
 pub use records::ParticleRecord;
 use records::{Migrant, history_of};
-pub use share::{Share, all_gather, gather_to_first};
+pub use share::{Share, all_gather, all_to_all, gather_to_first};
 
 /// Steps one rank's share of a decomposed world.
 ///
@@ -260,11 +261,13 @@ impl<E: Exchange> RankStepper<E> {
             .collect();
         let leaving = |i: usize| owners.get(i).is_some_and(|&o| o != me);
         let mut gone = Vec::new();
+        let fluid = world.fluid.as_ref();
         for (i, &owner) in owners.iter().enumerate().filter(|&(i, _)| leaving(i)) {
             gone.push(p.id[i]);
             outgoing[owner].push(Migrant {
                 particle: ParticleRecord::of(p, i),
                 history: history_of(&history, p.id[i]),
+                fluid_share: fluid.and_then(|f| f.shares.row_of(p.id[i])),
             });
         }
         history.walls.retain(|(key, _)| !gone.contains(&key.0));
@@ -274,11 +277,17 @@ impl<E: Exchange> RankStepper<E> {
         let arrived: Vec<Vec<Migrant>> = self.exchange.all_to_all(outgoing);
         let mut pairs: BTreeMap<_, _> = history.pairs.into_iter().collect();
         let mut walls: BTreeMap<_, _> = history.walls.into_iter().collect();
+        let stayed = world.particles.id.clone();
+        let mut fluid_shares = Vec::new();
         for m in arrived.into_iter().flatten() {
             m.particle.push_into(&mut world.particles);
             pairs.extend(m.history.pairs);
             walls.extend(m.history.walls);
+            fluid_shares.extend(m.fluid_share.map(|row| (m.particle.id, row)));
             self.migrated += 1;
+        }
+        if let Some(fluid) = world.fluid.as_mut() {
+            fluid.shares = fluid.shares.keep(&stayed, &fluid_shares);
         }
         self.choose_ghosts(world);
         let stats = *self.backend.stats();

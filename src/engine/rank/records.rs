@@ -6,7 +6,7 @@ use nalgebra::{Point3, UnitQuaternion, Vector3};
 use crate::Real;
 use crate::engine::backend::ContactHistory;
 use crate::engine::wire::{Message, Words};
-use crate::world::Particles;
+use crate::world::{Particles, ShareRow};
 
 /// A particle's state as it travels between ranks.
 #[derive(Clone, Debug, PartialEq)]
@@ -84,21 +84,28 @@ impl Message for Migrant {
     fn encode(&self, out: &mut Vec<u64>) {
         self.particle.encode(out);
         self.history.encode(out);
+        self.fluid_share.encode(out);
     }
     fn decode(words: &mut Words<'_>) -> Self {
         let particle = ParticleRecord::decode(words);
+        let history = ContactHistory::decode(words);
         Migrant {
             particle,
-            history: ContactHistory::decode(words),
+            history,
+            fluid_share: Option::decode(words),
         }
     }
 }
 
-/// A particle changing owner, with the history of its pairs and wall patches.
+/// A particle changing owner, with the history of its pairs and wall patches and,
+/// with a coupled fluid, its row of the fluid's cell shares (so that it reads the
+/// fluid and gives back its drag through the same cells as in one process until
+/// the shares are computed again).
 #[derive(Clone, Debug)]
 pub(super) struct Migrant {
     pub(super) particle: ParticleRecord,
     pub(super) history: ContactHistory,
+    pub(super) fluid_share: Option<ShareRow>,
 }
 
 /// The entries of `history` that concern particle `id`.

@@ -37,6 +37,17 @@ pub fn all_gather<T: Message>(share: &dyn Share, mine: &[T]) -> Vec<Vec<T>> {
         .collect()
 }
 
+/// Sends `outgoing[r]` to rank `r`; returns what every rank sent this one, in rank
+/// order.
+pub fn all_to_all<T: Message>(share: &dyn Share, outgoing: &[Vec<T>]) -> Vec<Vec<T>> {
+    let words = outgoing.iter().map(|list| encode_list(list)).collect();
+    share
+        .all_to_all_words(words)
+        .iter()
+        .map(|w| decode_list(w))
+        .collect()
+}
+
 /// Every rank's `mine`, in rank order, on rank 0 (empty elsewhere).
 pub fn gather_to_first<T: Message>(share: &dyn Share, mine: &[T]) -> Vec<Vec<T>> {
     let mut outgoing = vec![Vec::new(); share.ranks()];
