@@ -365,6 +365,17 @@ fn a_run_writes_the_drum_files() {
     assert!((json["average_from"].as_f64().unwrap() - 0.3).abs() < 1e-4);
     assert!((json["angular_speed"].as_f64().unwrap() - 3.0).abs() < 1e-9);
     assert!(json["drive_torque"].as_f64().unwrap() > 0.0);
+    // The signs of the regime: a bed lying in the lower half, carried up by the
+    // shell (spheres rolling on it carry less than its speed) under a surface.
+    let signs = &json["flow_signs"];
+    let co_rotation = signs["co_rotation"].as_f64().unwrap();
+    assert!(co_rotation > 0.05 && co_rotation < 1.05, "{signs}");
+    let coverage = signs["rim_coverage"].as_f64().unwrap();
+    assert!(coverage > 0.2 && coverage < 0.7, "{signs}");
+    assert!(
+        signs["surface_curvature"].as_f64().unwrap() > 0.0,
+        "{signs}"
+    );
     let summary: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
     assert_eq!(summary["drum"]["samples"], json["samples"]);

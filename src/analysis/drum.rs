@@ -1,6 +1,7 @@
 //! Rotating-drum figures: drive torque and power, the torque on each of the drum's
 //! walls, the dynamic angle of repose per revolution, a time-averaged velocity field
-//! of the cross-section and the flowing-layer thickness.
+//! of the cross-section, the flowing-layer thickness and the signs of the flow
+//! regime.
 //!
 //! A drum is one or more walls that turn together (a shell and the end caps attached
 //! to it, see `motion = { kind = "attached" }`) about an axis through the first
@@ -16,6 +17,7 @@ use nalgebra::{Point3, Vector3};
 use serde::{Deserialize, Serialize};
 
 use super::field::VelocityField;
+use super::regime::{FlowSignSums, FlowSigns};
 use super::surface::{SurfaceFit, fit_surface};
 use crate::Real;
 use crate::world::{MassMoments, World};
@@ -239,6 +241,8 @@ pub struct DrumSummary {
     /// Mean fraction of the slice's particles more than two diameters above the
     /// fitted surface (in flight).
     pub airborne_fraction: Option<Real>,
+    /// The signs of the flow regime the samples show (see [`super::regime`]).
+    pub flow_signs: Option<FlowSigns>,
     /// Flowing-layer thickness at the middle of the surface, m.
     pub flowing_layer: Option<Real>,
     /// Particle volume over the drum's volume.
@@ -267,6 +271,10 @@ pub struct DrumMonitor {
     angles: Vec<Real>,
     slopes: (Real, Real, usize),
     airborne: (Real, usize),
+    /// What the samples say of the flow regime (absent in checkpoints written
+    /// before it was kept: those runs start it at their resume).
+    #[serde(default)]
+    regime: FlowSignSums,
     turned: Real,
     next_sample: Real,
     last_angle: Option<Real>,
@@ -289,6 +297,7 @@ impl DrumMonitor {
             angles: Vec::new(),
             slopes: (0.0, 0.0, 0),
             airborne: (0.0, 0),
+            regime: FlowSignSums::default(),
             turned: 0.0,
             next_sample: world.time,
             last_angle: None,
@@ -351,6 +360,13 @@ impl DrumMonitor {
             return;
         }
         self.field.add_sample(&particles);
+        self.regime.add(
+            &particles,
+            self.drum.angular_speed(world),
+            self.drum.radius,
+            self.drum.diameter,
+            fit.as_ref(),
+        );
         if let Some(f) = fit {
             self.angles.push(f.angle_degrees());
             self.slopes.0 += f.slope;
@@ -454,6 +470,7 @@ impl DrumMonitor {
             })
             .sum();
         let drum_volume = std::f64::consts::PI * self.drum.radius.powi(2) * self.drum.length;
+        let airborne = (self.airborne.1 > 0).then(|| self.airborne.0 / self.airborne.1 as Real);
         DrumSummary {
             average_from: self.window_start,
             averaged_over: span,
@@ -482,8 +499,8 @@ impl DrumMonitor {
             gravity_moment: mean(w.moment),
             angle_of_repose: angle,
             angle_of_repose_std: std,
-            airborne_fraction: (self.airborne.1 > 0)
-                .then(|| self.airborne.0 / self.airborne.1 as Real),
+            airborne_fraction: airborne,
+            flow_signs: self.regime.signs(),
             flowing_layer: self
                 .mean_surface()
                 .and_then(|s| self.field.flowing_layer(&s)),

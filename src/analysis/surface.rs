@@ -77,10 +77,12 @@ pub fn fit_surface(points: &[[Real; 2]], diameter: Real) -> Option<SurfaceFit> {
     Some(fit)
 }
 
-/// One fit with columns along the v axis.
-fn fit_in_columns(points: &[[Real; 2]], diameter: Real) -> Option<SurfaceFit> {
-    if !(diameter > 0.0) || points.is_empty() {
-        return None;
+/// The surface's points: in columns 1.5 `diameter`s wide along the v axis, each
+/// column's highest centre with two more within two diameters below it (so that
+/// particles in flight are not the surface), in the order of the columns.
+pub fn surface_points(points: &[[Real; 2]], diameter: Real) -> Vec<[Real; 2]> {
+    if !(diameter > 0.0) {
+        return Vec::new();
     }
     let mut columns: std::collections::BTreeMap<i64, Vec<[Real; 2]>> = Default::default();
     for p in points {
@@ -99,6 +101,15 @@ fn fit_in_columns(points: &[[Real; 2]], diameter: Real) -> Option<SurfaceFit> {
         {
             surface.push(column[k]);
         }
+    }
+    surface
+}
+
+/// One fit with columns along the v axis.
+fn fit_in_columns(points: &[[Real; 2]], diameter: Real) -> Option<SurfaceFit> {
+    let surface = surface_points(points, diameter);
+    if surface.is_empty() {
+        return None;
     }
     let (lo, hi) = surface
         .iter()
