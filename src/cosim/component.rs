@@ -620,19 +620,15 @@ impl Component {
 
     /// Each particle's id and what the fluid does to it (drag of the last force
     /// evaluation, slip, local voidage: [`ParticleFluid`]), in the simulation's
-    /// order (on ranks the whole run's, in id order, on rank 0); before
-    /// initialisation the scene's particles at rest in the start fields (no drag
-    /// yet). Particles come and go, so this crosses the faces as
-    /// whole lists (C API, zenoh), not as variables.
+    /// order (on ranks collective: the whole run's, in id order, on rank 0, empty
+    /// lists on the others); before initialisation the scene's particles at rest in
+    /// the start fields (no drag yet). Particles come and go, so this crosses the
+    /// faces as whole lists (C API, zenoh), not as variables.
     pub fn particle_fluid(&self) -> Result<(Vec<u64>, Vec<ParticleFluid>), CosimError> {
         let world = self.world();
         let fluid = world.fluid.as_ref().ok_or(CosimError::NoFluid)?;
-        if let Some(whole) = self
-            .gathered
-            .as_ref()
-            .and_then(|g| g.particle_fluid.clone())
-        {
-            return Ok(whole);
+        if let (Some(_), Some(sim)) = (&self.ranks, &self.sim) {
+            return Ok(sim.whole_particle_fluid().unwrap_or_default());
         }
         let p = &world.particles;
         let n = p.owned();

@@ -7,9 +7,10 @@
 //!   (see [`crate::scene::ranks`]); the figures of the particles are the whole run's
 //!   sums; a coupled fluid's solid fraction and mean particle velocity are the whole
 //!   run's on every rank. What needs the whole world (facet forces, the drum's
-//!   angle of repose, the bed's figures, a fluid's momentum source and what it does
-//!   to each particle) is gathered on rank 0 after each change of the state: rank 0
-//!   answers the host; the other ranks' answers are never sent.
+//!   angle of repose, the bed's figures, a fluid's momentum source) is gathered on
+//!   rank 0 after each change of the state: rank 0 answers the host; the other
+//!   ranks' answers are never sent. What a fluid does to each particle is gathered
+//!   when it is read ([`Component::particle_fluid`], collective on ranks).
 //! - **States**: a saved state is the whole run's, gathered on rank 0 and sent back
 //!   to every rank, the same bytes one process saves; a restore (of a state saved
 //!   on any number of ranks, or in one process) builds the simulation anew on the
@@ -24,7 +25,6 @@ use crate::Real;
 use crate::analysis::packing::{BedFigures, bed_figures};
 use crate::engine::exchange::{Ranks, broadcast_bytes};
 use crate::scene::{Scene, ShareState, SimState, Simulation, StateReader, StateWriter};
-use crate::world::ParticleFluid;
 
 /// What rank 0 reads of the whole run that no rank's share holds, gathered after
 /// every change of the state.
@@ -38,8 +38,6 @@ pub(super) struct Gathered {
     pub(super) bed: Option<BedFigures>,
     /// A coupled fluid's momentum source per cell.
     pub(super) momentum_source: Option<Vec<Vector3<Real>>>,
-    /// Each particle's id and what a coupled fluid does to it, in id order.
-    pub(super) particle_fluid: Option<(Vec<u64>, Vec<ParticleFluid>)>,
 }
 
 impl Component {
@@ -123,21 +121,18 @@ impl Component {
             .expect("a running component has a simulation");
         let scene = &self.scene;
         let momentum_source = sim.whole_momentum_source();
-        let particle_fluid = sim.whole_particle_fluid();
         self.gathered = (|| {
             if scene.drum.is_none() && scene.bed.is_none() {
                 let facet_forces = sim.whole_facet_forces()?;
                 return Some(Gathered {
                     facet_forces,
                     momentum_source,
-                    particle_fluid,
                     ..Gathered::default()
                 });
             }
             let world = sim.whole_world()?;
             Some(Gathered {
                 momentum_source,
-                particle_fluid,
                 facet_forces: world.walls.iter().map(|w| w.facet_force.clone()).collect(),
                 angle_of_repose: scene
                     .drum

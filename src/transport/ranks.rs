@@ -2,7 +2,8 @@
 //! every request that changes the component's state (a step, a state saved or
 //! restored, a call of the life cycle) is handed to every other rank before rank 0 answers it, and every
 //! rank's service makes the same call with the same bytes, so the ranks' components
-//! stay one decomposed run (see [`crate::cosim`]'s component on ranks). The other
+//! stay one decomposed run (see [`crate::cosim`]'s component on ranks); so is a
+//! `<key>/fluid` request, whose particles every rank gathers to rank 0. The other
 //! requests read what rank 0 holds and are answered by it alone.
 
 use crate::cosim::{Component, CosimError, Mode};
@@ -23,11 +24,13 @@ pub(super) enum Call {
     State = 2,
     /// A `<key>/call` request that changes the component.
     Life = 3,
+    /// A `<key>/fluid` request (each particle's fluid is gathered from every rank).
+    Fluid = 4,
 }
 
 impl Call {
     fn of(byte: u8) -> Option<Call> {
-        [Call::Stop, Call::Step, Call::State, Call::Life]
+        [Call::Stop, Call::Step, Call::State, Call::Life, Call::Fluid]
             .into_iter()
             .find(|c| *c as u8 == byte)
     }
@@ -69,6 +72,7 @@ impl Service {
                 Call::Step => drop(self.step(payload)),
                 Call::State => drop(self.state(payload)),
                 Call::Life => drop(self.call(payload)),
+                Call::Fluid => drop(self.fluid(payload)),
             }
         }
         end(self.component)

@@ -331,8 +331,9 @@ impl Service {
     }
 
     /// `<key>/fluid`: the grid and the per-cell fields of a coupled fluid (and, when
-    /// asked, what the fluid does to each particle).
+    /// asked, what the fluid does to each particle: on ranks gathered from all).
     pub fn fluid(&self, payload: &[u8]) -> pb::FluidReply {
+        self.tell_ranks(Call::Fluid, payload);
         let result = (|| {
             let request = pb::FluidRequest::decode(payload)
                 .map_err(|e| format!("malformed FluidRequest: {e}"))?;
