@@ -1,7 +1,26 @@
 //! Generates the protobuf types of the zenoh transport (feature `zenoh`) with the
-//! vendored protoc, so no system protoc is needed.
+//! vendored protoc, so no system protoc is needed; compiles the CUDA kernels as C++
+//! for the host executor (feature `cuda`).
 
 fn main() {
+    #[cfg(feature = "cuda")]
+    {
+        for f in ["host.h", "host.cpp", "integrate.cu"] {
+            println!("cargo:rerun-if-changed=kernels/{f}");
+        }
+        // No contraction into fused multiply-adds: the host executor computes what
+        // the CPU backend computes, operation by operation.
+        cc::Build::new()
+            .cpp(true)
+            .file("kernels/host.cpp")
+            .include("kernels")
+            .flag("-std=c++17")
+            .flag("-ffp-contract=off")
+            .warnings(true)
+            .extra_warnings(true)
+            .warnings_into_errors(true)
+            .compile("talus_kernels_host");
+    }
     #[cfg(feature = "zenoh")]
     {
         println!("cargo:rerun-if-changed=proto/talus/v1/talus.proto");

@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
 # Installs the Debian packages the tests need, where missing: OpenMPI (headers, and
-# mpirun for the tests that run ranks) and libclang, with which the `mpi` crate
-# generates its bindings. Uses sudo when not root.
+# mpirun for the tests that run ranks), libclang, with which the `mpi` crate
+# generates its bindings, and g++, which compiles the CUDA kernels for the host
+# executor. Uses sudo when not root.
 set -euo pipefail
-packages=(libopenmpi-dev openmpi-bin libclang-dev)
+packages=(libopenmpi-dev openmpi-bin libclang-dev g++)
 missing=()
 for p in "${packages[@]}"; do
     dpkg -s "$p" >/dev/null 2>&1 || missing+=("$p")

@@ -16,6 +16,8 @@
 pub mod backend;
 pub mod broad_phase;
 pub mod cpu;
+#[cfg(feature = "cuda")]
+pub mod cuda;
 pub mod decomposition;
 #[cfg(test)]
 mod decomposition_tests;

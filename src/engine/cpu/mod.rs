@@ -21,7 +21,7 @@ mod dispatch;
 mod fluid;
 mod forces;
 mod hertz;
-mod motion;
+pub(crate) mod motion;
 mod pairs;
 mod patch;
 mod relative_motion;

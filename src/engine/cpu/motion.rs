@@ -13,7 +13,7 @@ const PARTICLES_PER_TASK: usize = 256;
 
 /// Half kick with the forces of the last evaluation, drift, and free rotation of every
 /// owned particle that is not frozen. Returns how many were integrated.
-pub(super) fn kick_drift(world: &mut World, dt: Real) -> usize {
+pub(crate) fn kick_drift(world: &mut World, dt: Real) -> usize {
     let types = &world.body_types;
     let p = &mut world.particles;
     let n = p.owned();

@@ -1,0 +1,141 @@
+// The opening kick and drift of the owned particles (engine/cpu/motion.rs,
+// engine/integrate.rs), one thread per particle: velocity Verlet for translation
+// with the forces of the last evaluation, and for rotation a half kick of the
+// world-frame angular momentum followed by the torque-free rotation of the implicit
+// midpoint rule, whose orientation turns by the Cayley rotation of the midpoint
+// angular velocity (closed form for an isotropic body, fixed-point iteration to
+// round-off otherwise).
+//
+// Layout, as the host world holds it: per particle 3 doubles of position,
+// velocity, angular momentum, force and torque; the orientation as a unit
+// quaternion (i, j, k, w); its body type; frozen as a byte (0 or 1). Per body
+// type: the mass and the 3 principal moments of inertia.
+
+struct Vec3 {
+    double x, y, z;
+};
+
+// A quaternion w + x i + y j + z k.
+struct Quat {
+    double w, x, y, z;
+};
+
+static __device__ __forceinline__ Vec3 load3(const double* a, unsigned i) {
+    return Vec3{a[3 * i], a[3 * i + 1], a[3 * i + 2]};
+}
+
+static __device__ __forceinline__ void store3(double* a, unsigned i, Vec3 v) {
+    a[3 * i] = v.x;
+    a[3 * i + 1] = v.y;
+    a[3 * i + 2] = v.z;
+}
+
+static __device__ __forceinline__ Vec3 add(Vec3 a, Vec3 b) {
+    return Vec3{a.x + b.x, a.y + b.y, a.z + b.z};
+}
+
+static __device__ __forceinline__ Vec3 sub(Vec3 a, Vec3 b) {
+    return Vec3{a.x - b.x, a.y - b.y, a.z - b.z};
+}
+
+static __device__ __forceinline__ Vec3 scale(Vec3 a, double s) {
+    return Vec3{a.x * s, a.y * s, a.z * s};
+}
+
+static __device__ __forceinline__ Vec3 mul(Vec3 a, Vec3 b) {
+    return Vec3{a.x * b.x, a.y * b.y, a.z * b.z};
+}
+
+static __device__ __forceinline__ Vec3 cross(Vec3 a, Vec3 b) {
+    return Vec3{a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+
+static __device__ __forceinline__ double norm(Vec3 a) {
+    return sqrt(a.x * a.x + a.y * a.y + a.z * a.z);
+}
+
+static __device__ __forceinline__ Quat qmul(Quat a, Quat b) {
+    return Quat{
+        a.w * b.w - a.x * b.x - a.y * b.y - a.z * b.z,
+        a.w * b.x + a.x * b.w + a.y * b.z - a.z * b.y,
+        a.w * b.y - a.x * b.z + a.y * b.w + a.z * b.x,
+        a.w * b.z + a.x * b.y - a.y * b.x + a.z * b.w,
+    };
+}
+
+static __device__ __forceinline__ Quat normalised(Quat q) {
+    double s = 1.0 / sqrt(q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z);
+    return Quat{q.w * s, q.x * s, q.y * s, q.z * s};
+}
+
+// v turned by the unit quaternion q: v + 2 w (u × v) + 2 u × (u × v), u = (x, y, z).
+static __device__ __forceinline__ Vec3 rotate(Quat q, Vec3 v) {
+    Vec3 u = Vec3{q.x, q.y, q.z};
+    Vec3 t = scale(cross(u, v), 2.0);
+    return add(add(v, scale(t, q.w)), cross(u, t));
+}
+
+static __device__ __forceinline__ Quat conjugate(Quat q) {
+    return Quat{q.w, -q.x, -q.y, -q.z};
+}
+
+// C^T v for the Cayley rotation of w: v turned back by the unit quaternion (1, w)/|.|.
+static __device__ __forceinline__ Vec3 cayley_transpose(Vec3 w, Vec3 v) {
+    return rotate(conjugate(normalised(Quat{1.0, w.x, w.y, w.z})), v);
+}
+
+// The torque-free rotation over dt of a body of principal moments `inertia`.
+static __device__ void free_rotation(Quat* q, Vec3* l, Vec3 inertia, double dt) {
+    double most = fmax(inertia.x, fmax(inertia.y, inertia.z));
+    double least = fmin(inertia.x, fmin(inertia.y, inertia.z));
+    if (most - least <= 1e-12 * most) {
+        // L stays; the body turns by the Cayley rotation of h ω / 2: q + (0, w) ⊗ q
+        // with the world-frame w = L h / (2 I), normalised.
+        Vec3 w = scale(*l, 0.5 * dt / inertia.x);
+        Quat turned = qmul(Quat{0.0, w.x, w.y, w.z}, *q);
+        turned = Quat{q->w + turned.w, q->x + turned.x, q->y + turned.y, q->z + turned.z};
+        *q = normalised(turned);
+        return;
+    }
+    Vec3 l0 = rotate(conjugate(*q), *l);
+    Vec3 inverse = Vec3{1.0 / inertia.x, 1.0 / inertia.y, 1.0 / inertia.z};
+    double size = fmax(norm(l0), 2.2250738585072014e-308);
+    Vec3 l1 = l0;
+    for (int k = 0; k < 64; ++k) {
+        Vec3 w = scale(mul(scale(add(l0, l1), 0.5), inverse), 0.5 * dt);
+        Vec3 next = cayley_transpose(w, l0);
+        double change = norm(sub(next, l1));
+        l1 = next;
+        if (change <= 1e-15 * size) {
+            break;
+        }
+    }
+    Vec3 w = scale(mul(scale(add(l0, l1), 0.5), inverse), 0.5 * dt);
+    l1 = cayley_transpose(w, l0);
+    *q = normalised(qmul(*q, normalised(Quat{1.0, w.x, w.y, w.z})));
+    *l = rotate(*q, l1);
+}
+
+extern "C" __global__ void kick_drift(
+    unsigned n, double dt, double* position, double* velocity, double* orientation,
+    double* angular_momentum, const double* force, const double* torque,
+    const unsigned* body_type, const unsigned char* frozen, const double* mass,
+    const double* inertia) {
+    unsigned i = blockIdx.x * blockDim.x + threadIdx.x;
+    if (i >= n || frozen[i]) {
+        return;
+    }
+    unsigned kind = body_type[i];
+    Vec3 v = add(load3(velocity, i), scale(load3(force, i), 0.5 * dt / mass[kind]));
+    store3(velocity, i, v);
+    store3(position, i, add(load3(position, i), scale(v, dt)));
+    Quat q = Quat{orientation[4 * i + 3], orientation[4 * i], orientation[4 * i + 1],
+                  orientation[4 * i + 2]};
+    Vec3 l = add(load3(angular_momentum, i), scale(load3(torque, i), 0.5 * dt));
+    free_rotation(&q, &l, load3(inertia, kind), dt);
+    orientation[4 * i] = q.x;
+    orientation[4 * i + 1] = q.y;
+    orientation[4 * i + 2] = q.z;
+    orientation[4 * i + 3] = q.w;
+    store3(angular_momentum, i, l);
+}

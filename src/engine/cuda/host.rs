@@ -1,0 +1,227 @@
+//! The host executor: runs the kernels of `kernels/`, compiled as C++ by `build.rs`,
+//! on the CPU, as the driver launches them on a GPU: `threads` threads in blocks of
+//! [`HostExecutor::block`], each thread's indices set before its call, the
+//! parameters passed as an array of pointers to each argument. The blocks run in
+//! parallel on the rayon pool (the threads of a block one after the other), so a
+//! kernel whose threads race shows it here too.
+
+use std::ffi::c_void;
+
+use rayon::prelude::*;
+
+use super::Kernel;
+use crate::Real;
+use crate::world::World;
+
+unsafe extern "C" {
+    fn talus_host_at(block: u32, thread: u32, block_dim: u32, grid_dim: u32);
+    fn talus_host_kick_drift(params: *mut *mut c_void);
+}
+
+/// The parameters of one launch, shared by the threads that run its blocks.
+struct Params(*mut *mut c_void);
+
+// SAFETY: the pointers are read, never written, by the trampolines; what they point
+// to outlives the launch (see `HostExecutor::launch`).
+unsafe impl Sync for Params {}
+
+/// Runs kernels on the CPU (see the module).
+#[derive(Clone, Copy, Debug)]
+pub struct HostExecutor {
+    /// Threads per block.
+    pub block: u32,
+}
+
+impl Default for HostExecutor {
+    fn default() -> Self {
+        HostExecutor { block: 128 }
+    }
+}
+
+impl HostExecutor {
+    /// Runs `kernel` on `threads` threads.
+    ///
+    /// # Safety
+    /// `params` holds one pointer per parameter of the kernel, in order, each to a
+    /// value of the parameter's type, and every array the kernel reaches holds what
+    /// the kernel reads and writes for `threads` threads.
+    pub unsafe fn launch(&self, kernel: Kernel, threads: u32, params: &mut [*mut c_void]) {
+        let trampoline = match kernel {
+            Kernel::KickDrift => talus_host_kick_drift,
+        };
+        let block = self.block.max(1);
+        let blocks = threads.div_ceil(block);
+        let params = Params(params.as_mut_ptr());
+        (0..blocks).into_par_iter().for_each(|b| {
+            let params = &params;
+            for t in 0..block {
+                // SAFETY: the caller's contract; the indices are this OS thread's.
+                unsafe {
+                    talus_host_at(b, t, block, blocks);
+                    trampoline(params.0);
+                }
+            }
+        });
+    }
+
+    /// The opening kick and drift of `world`'s owned particles over `dt` through
+    /// [`Kernel::KickDrift`] (the CPU backend's first stage of a step).
+    pub fn kick_drift(&self, world: &mut World, dt: Real) {
+        let types = &world.body_types;
+        let mass: Vec<Real> = types.iter().map(|t| t.mass).collect();
+        let inertia: Vec<Real> = types
+            .iter()
+            .flat_map(|t| t.inertia.iter().copied())
+            .collect();
+        let p = &mut world.particles;
+        let mut n = u32::try_from(p.owned()).expect("fewer than 2^32 particles");
+        let mut dt = dt;
+        let frozen: Vec<u8> = p.frozen.iter().map(|&f| u8::from(f)).collect();
+        // nalgebra's points, vectors and quaternions are arrays of doubles (the
+        // quaternion as i, j, k, w), the layout the kernel reads.
+        let mut arrays: [*mut c_void; 10] = [
+            p.position.as_mut_ptr().cast(),
+            p.velocity.as_mut_ptr().cast(),
+            p.orientation.as_mut_ptr().cast(),
+            p.angular_momentum.as_mut_ptr().cast(),
+            p.force.as_ptr().cast_mut().cast(),
+            p.torque.as_ptr().cast_mut().cast(),
+            p.body_type.as_ptr().cast_mut().cast(),
+            frozen.as_ptr().cast_mut().cast(),
+            mass.as_ptr().cast_mut().cast(),
+            inertia.as_ptr().cast_mut().cast(),
+        ];
+        let mut params: Vec<*mut c_void> = vec![(&raw mut n).cast(), (&raw mut dt).cast()];
+        params.extend(arrays.iter_mut().map(|a| (a as *mut *mut c_void).cast()));
+        // SAFETY: the parameters of `kick_drift` in order; every array holds the
+        // owned particles' (or the body types') entries.
+        unsafe { self.launch(Kernel::KickDrift, n, &mut params) };
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::path::Path;
+
+    use nalgebra::{Point3, UnitQuaternion, Vector3};
+    use rand::{Rng, SeedableRng};
+    use rand_pcg::Pcg64;
+
+    use super::HostExecutor;
+    use crate::scene::Scene;
+
+    /// Spheres (isotropic), flat cuboids and rods (three distinct moments), with
+    /// random states and loads, every seventh frozen.
+    fn world() -> crate::world::World {
+        let text = r#"
+[simulation]
+dt = 1e-5
+end_time = 1.0
+[materials.m]
+density = 2500.0
+young = 1e7
+poisson = 0.3
+restitution = 0.5
+friction = 0.5
+[shapes.ball]
+kind = "sphere"
+radius = 0.005
+[shapes.slab]
+kind = "cuboid"
+size = [0.02, 0.01, 0.004]
+[shapes.rod]
+kind = "cuboid"
+size = [0.03, 0.005, 0.005]
+[[particles]]
+kind = "lattice"
+shape = "ball"
+material = "m"
+min = [0.0, 0.0, 0.0]
+max = [0.01, 0.01, 0.01]
+[[particles]]
+kind = "lattice"
+shape = "slab"
+material = "m"
+min = [0.1, 0.0, 0.0]
+max = [0.13, 0.03, 0.03]
+[[particles]]
+kind = "lattice"
+shape = "rod"
+material = "m"
+min = [0.2, 0.0, 0.0]
+max = [0.24, 0.04, 0.04]
+"#;
+        let mut world = Scene::parse(text, Path::new("kick.toml")).unwrap().world;
+        assert_eq!(world.body_types.len(), 3);
+        world.particles = Default::default();
+        let mut rng = Pcg64::seed_from_u64(23);
+        let mut v = |s: f64| Vector3::from_fn(|_, _| rng.random_range(-s..s));
+        let mut samples = Vec::new();
+        for k in 0..1000 {
+            samples.push((k % 3, v(0.5), v(2.0), v(1e-3), v(1e-6), v(1e-5), v(1.0)));
+        }
+        let p = &mut world.particles;
+        for (k, (kind, x, u, f, t, l, axis)) in samples.into_iter().enumerate() {
+            let q = UnitQuaternion::from_scaled_axis(axis * 3.0);
+            p.push(kind as u32, Point3::from(x), q, k as u64);
+            let i = p.len() - 1;
+            p.velocity[i] = u;
+            p.force[i] = f;
+            p.torque[i] = t;
+            p.angular_momentum[i] = l;
+            p.frozen[i] = k % 7 == 0;
+        }
+        world
+    }
+
+    /// The kernel, run by the host executor in blocks of 32 (the last one partly
+    /// idle), moves every particle as the CPU backend's stage: positions,
+    /// velocities, orientations and angular momenta within 1e-14 of their size
+    /// (the same operations, some in another order: a few units in the last place),
+    /// frozen ones untouched.
+    #[test]
+    fn the_kick_drift_kernel_moves_particles_as_the_cpu_backend() {
+        let before = world();
+        let dt = 2e-4;
+        let mut cpu = before.clone();
+        crate::engine::cpu::motion::kick_drift(&mut cpu, dt);
+        let mut kernel = before.clone();
+        HostExecutor { block: 32 }.kick_drift(&mut kernel, dt);
+        let (a, b) = (&cpu.particles, &kernel.particles);
+        let close = |x: &[f64], y: &[f64]| {
+            let size = x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            x.iter().zip(y).all(|(u, v)| (u - v).abs() <= 1e-14 * size)
+        };
+        let mut turned = 0;
+        for i in 0..a.len() {
+            assert!(close(
+                a.position[i].coords.as_slice(),
+                b.position[i].coords.as_slice()
+            ));
+            assert!(
+                close(a.velocity[i].as_slice(), b.velocity[i].as_slice()),
+                "{i}"
+            );
+            assert!(close(
+                a.orientation[i].coords.as_slice(),
+                b.orientation[i].coords.as_slice()
+            ));
+            assert!(
+                close(
+                    a.angular_momentum[i].as_slice(),
+                    b.angular_momentum[i].as_slice()
+                ),
+                "{i}: {} against {}",
+                a.angular_momentum[i],
+                b.angular_momentum[i]
+            );
+            if before.particles.frozen[i] {
+                assert_eq!(b.position[i], before.particles.position[i]);
+                assert_eq!(b.orientation[i], before.particles.orientation[i]);
+            } else {
+                turned += usize::from(b.orientation[i] != before.particles.orientation[i]);
+            }
+        }
+        assert!(turned > 800, "{turned} turned");
+    }
+}

@@ -1,0 +1,73 @@
+//! The kernels compiled to PTX by NVRTC, which needs no GPU: cudarc loads
+//! `libnvrtc` at run time (the CUDA toolkit's, or PyPI's `nvidia-cuda-nvrtc-cu12`
+//! with its `lib` directory on `LD_LIBRARY_PATH`).
+
+use super::Kernel;
+
+/// The GPU architectures every kernel is compiled for: Ampere (A100) and Hopper
+/// (H100, H200).
+pub const ARCHITECTURES: [&str; 2] = ["sm_80", "sm_90"];
+
+/// Why a kernel was not compiled.
+#[derive(Debug, thiserror::Error)]
+pub enum NvrtcError {
+    /// No NVRTC library could be loaded.
+    #[error(
+        "NVRTC (libnvrtc) is not found: install the CUDA toolkit, or `pip install \
+         nvidia-cuda-nvrtc-cu12` and put its nvidia/cuda_nvrtc/lib on LD_LIBRARY_PATH"
+    )]
+    Missing,
+    /// NVRTC refused the source.
+    #[error("kernels/{file}: NVRTC for {arch}: {log}")]
+    Compile {
+        /// The source file.
+        file: &'static str,
+        /// The architecture.
+        arch: &'static str,
+        /// What NVRTC said.
+        log: String,
+    },
+}
+
+/// Whether an NVRTC library can be loaded.
+pub fn is_present() -> bool {
+    // SAFETY: only tries to open the library (cudarc panics on a missing one later).
+    unsafe { cudarc::nvrtc::sys::is_culib_present() }
+}
+
+/// `kernel`'s source compiled to PTX for `arch` (one of [`ARCHITECTURES`]), in
+/// double precision with IEEE division and square roots.
+pub fn compile(kernel: Kernel, arch: &'static str) -> Result<String, NvrtcError> {
+    compile_source(kernel.file(), kernel.source(), arch)
+}
+
+/// [`compile`] of the text `source` of the file `file`.
+pub fn compile_source(
+    file: &'static str,
+    source: &str,
+    arch: &'static str,
+) -> Result<String, NvrtcError> {
+    if !is_present() {
+        return Err(NvrtcError::Missing);
+    }
+    let options = cudarc::nvrtc::CompileOptions {
+        arch: Some(arch),
+        prec_div: Some(true),
+        prec_sqrt: Some(true),
+        ftz: Some(false),
+        name: Some(file.into()),
+        ..Default::default()
+    };
+    cudarc::nvrtc::compile_ptx_with_opts(source, options)
+        .map(|ptx| ptx.to_src())
+        .map_err(|e| NvrtcError::Compile {
+            file,
+            arch,
+            log: match e {
+                cudarc::nvrtc::CompileError::CompileError { log, .. } => {
+                    log.to_string_lossy().into_owned()
+                }
+                other => format!("{other:?}"),
+            },
+        })
+}

@@ -1,0 +1,40 @@
+//! The CUDA kernels compile with NVRTC (no GPU needed) for every architecture talus
+//! supports, and a kernel NVRTC refuses is reported with its file and NVRTC's log.
+//! Where no NVRTC library is found the test says so and passes, unless
+//! `TALUS_REQUIRE_NVRTC` is set, as the test script sets it after installing PyPI's
+//! `nvidia-cuda-nvrtc-cu12`.
+#![cfg(feature = "cuda")]
+
+use talus::engine::cuda::Kernel;
+use talus::engine::cuda::nvrtc::{ARCHITECTURES, NvrtcError, compile, compile_source, is_present};
+
+#[test]
+fn every_kernel_compiles_with_nvrtc_for_every_architecture() {
+    if !is_present() {
+        assert!(
+            std::env::var_os("TALUS_REQUIRE_NVRTC").is_none(),
+            "TALUS_REQUIRE_NVRTC is set: {}",
+            NvrtcError::Missing
+        );
+        eprintln!("skipped: {}", NvrtcError::Missing);
+        return;
+    }
+    for kernel in Kernel::ALL {
+        for arch in ARCHITECTURES {
+            let ptx = compile(kernel, arch).unwrap_or_else(|e| panic!("{e}"));
+            assert!(ptx.contains(&format!(".target {arch}")), "{arch}");
+            assert!(
+                ptx.contains(&format!(".entry {}(", kernel.name())),
+                "{} in {arch}'s PTX",
+                kernel.name()
+            );
+        }
+    }
+    let broken = "extern \"C\" __global__ void k(double* x) { x[0] = undeclared; }";
+    let err = compile_source("broken.cu", broken, "sm_80").unwrap_err();
+    let said = err.to_string();
+    assert!(
+        said.starts_with("kernels/broken.cu: NVRTC for sm_80: ") && said.contains("undeclared"),
+        "{said}"
+    );
+}
