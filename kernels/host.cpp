@@ -24,6 +24,12 @@ static T arg(void** p, int k) {
     return *static_cast<T*>(p[k]);
 }
 
+extern "C" void talus_host_closing_kick(void** p) {
+    closing_kick(arg<unsigned>(p, 0), arg<double>(p, 1), arg<double*>(p, 2), arg<double*>(p, 3),
+                 arg<const double*>(p, 4), arg<const double*>(p, 5), arg<const unsigned*>(p, 6),
+                 arg<const unsigned char*>(p, 7), arg<const double*>(p, 8));
+}
+
 extern "C" void talus_host_kick_drift(void** p) {
     kick_drift(arg<unsigned>(p, 0), arg<double>(p, 1), arg<double*>(p, 2), arg<double*>(p, 3),
                arg<double*>(p, 4), arg<double*>(p, 5), arg<const double*>(p, 6),

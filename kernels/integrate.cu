@@ -1,4 +1,5 @@
-// The opening kick and drift of the owned particles (engine/cpu/motion.rs,
+// The kick–drift–kick of the owned particles. First the opening kick and drift
+// (engine/cpu/motion.rs,
 // engine/integrate.rs), one thread per particle: velocity Verlet for translation
 // with the forces of the last evaluation, and for rotation a half kick of the
 // world-frame angular momentum followed by the torque-free rotation of the implicit
@@ -138,4 +139,20 @@ extern "C" __global__ void kick_drift(
     orientation[4 * i + 2] = q.z;
     orientation[4 * i + 3] = q.w;
     store3(angular_momentum, i, l);
+}
+
+// The closing half kick with the forces just evaluated (engine/cpu/motion.rs), one
+// thread per particle: the CPU backend's operations in its order, so the same bits.
+extern "C" __global__ void closing_kick(
+    unsigned n, double dt, double* velocity, double* angular_momentum,
+    const double* force, const double* torque, const unsigned* body_type,
+    const unsigned char* frozen, const double* mass) {
+    unsigned i = blockIdx.x * blockDim.x + threadIdx.x;
+    if (i >= n || frozen[i]) {
+        return;
+    }
+    Vec3 v = add(load3(velocity, i), scale(load3(force, i), 0.5 * dt / mass[body_type[i]]));
+    store3(velocity, i, v);
+    store3(angular_momentum, i,
+           add(load3(angular_momentum, i), scale(load3(torque, i), 0.5 * dt)));
 }

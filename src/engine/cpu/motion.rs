@@ -61,7 +61,7 @@ pub(super) fn advance_walls(world: &mut World, dt: Real) {
 }
 
 /// The closing half kick with the forces just evaluated.
-pub(super) fn closing_kick(world: &mut World, dt: Real) {
+pub(crate) fn closing_kick(world: &mut World, dt: Real) {
     let types = &world.body_types;
     let p = &mut world.particles;
     let n = p.owned();

@@ -16,6 +16,7 @@ use crate::world::World;
 unsafe extern "C" {
     fn talus_host_at(block: u32, thread: u32, block_dim: u32, grid_dim: u32);
     fn talus_host_kick_drift(params: *mut *mut c_void);
+    fn talus_host_closing_kick(params: *mut *mut c_void);
 }
 
 /// The parameters of one launch, shared by the threads that run its blocks.
@@ -48,6 +49,7 @@ impl HostExecutor {
     pub unsafe fn launch(&self, kernel: Kernel, threads: u32, params: &mut [*mut c_void]) {
         let trampoline = match kernel {
             Kernel::KickDrift => talus_host_kick_drift,
+            Kernel::ClosingKick => talus_host_closing_kick,
         };
         let block = self.block.max(1);
         let blocks = threads.div_ceil(block);
@@ -67,19 +69,12 @@ impl HostExecutor {
     /// The opening kick and drift of `world`'s owned particles over `dt` through
     /// [`Kernel::KickDrift`] (the CPU backend's first stage of a step).
     pub fn kick_drift(&self, world: &mut World, dt: Real) {
-        let types = &world.body_types;
-        let mass: Vec<Real> = types.iter().map(|t| t.mass).collect();
-        let inertia: Vec<Real> = types
-            .iter()
-            .flat_map(|t| t.inertia.iter().copied())
-            .collect();
+        let types = TypeArrays::of(world);
         let p = &mut world.particles;
-        let mut n = u32::try_from(p.owned()).expect("fewer than 2^32 particles");
-        let mut dt = dt;
         let frozen: Vec<u8> = p.frozen.iter().map(|&f| u8::from(f)).collect();
         // nalgebra's points, vectors and quaternions are arrays of doubles (the
         // quaternion as i, j, k, w), the layout the kernel reads.
-        let mut arrays: [*mut c_void; 10] = [
+        let arrays = [
             p.position.as_mut_ptr().cast(),
             p.velocity.as_mut_ptr().cast(),
             p.orientation.as_mut_ptr().cast(),
@@ -88,14 +83,69 @@ impl HostExecutor {
             p.torque.as_ptr().cast_mut().cast(),
             p.body_type.as_ptr().cast_mut().cast(),
             frozen.as_ptr().cast_mut().cast(),
-            mass.as_ptr().cast_mut().cast(),
-            inertia.as_ptr().cast_mut().cast(),
+            types.mass.as_ptr().cast_mut().cast(),
+            types.inertia.as_ptr().cast_mut().cast(),
         ];
-        let mut params: Vec<*mut c_void> = vec![(&raw mut n).cast(), (&raw mut dt).cast()];
-        params.extend(arrays.iter_mut().map(|a| (a as *mut *mut c_void).cast()));
         // SAFETY: the parameters of `kick_drift` in order; every array holds the
         // owned particles' (or the body types') entries.
-        unsafe { self.launch(Kernel::KickDrift, n, &mut params) };
+        unsafe { self.launch_on_particles(Kernel::KickDrift, p.owned(), dt, arrays) };
+    }
+
+    /// The closing half kick of `world`'s owned particles over `dt` through
+    /// [`Kernel::ClosingKick`] (the CPU backend's last stage of a step).
+    pub fn closing_kick(&self, world: &mut World, dt: Real) {
+        let types = TypeArrays::of(world);
+        let p = &mut world.particles;
+        let frozen: Vec<u8> = p.frozen.iter().map(|&f| u8::from(f)).collect();
+        let arrays = [
+            p.velocity.as_mut_ptr().cast(),
+            p.angular_momentum.as_mut_ptr().cast(),
+            p.force.as_ptr().cast_mut().cast(),
+            p.torque.as_ptr().cast_mut().cast(),
+            p.body_type.as_ptr().cast_mut().cast(),
+            frozen.as_ptr().cast_mut().cast(),
+            types.mass.as_ptr().cast_mut().cast(),
+        ];
+        // SAFETY: the parameters of `closing_kick` in order, as above.
+        unsafe { self.launch_on_particles(Kernel::ClosingKick, p.owned(), dt, arrays) };
+    }
+
+    /// Launches a kernel of parameters `(n, dt, arrays...)` on `n` threads.
+    ///
+    /// # Safety
+    /// As [`Self::launch`]: `arrays` are the kernel's array parameters in order.
+    unsafe fn launch_on_particles<const K: usize>(
+        &self,
+        kernel: Kernel,
+        n: usize,
+        mut dt: Real,
+        mut arrays: [*mut c_void; K],
+    ) {
+        let mut n = u32::try_from(n).expect("fewer than 2^32 particles");
+        let mut params: Vec<*mut c_void> = vec![(&raw mut n).cast(), (&raw mut dt).cast()];
+        params.extend(arrays.iter_mut().map(|a| (a as *mut *mut c_void).cast()));
+        // SAFETY: the caller's contract.
+        unsafe { self.launch(kernel, n, &mut params) };
+    }
+}
+
+/// Per body type, what the integration kernels read: the mass and the principal
+/// moments of inertia (3 doubles each).
+struct TypeArrays {
+    mass: Vec<Real>,
+    inertia: Vec<Real>,
+}
+
+impl TypeArrays {
+    fn of(world: &World) -> Self {
+        let types = &world.body_types;
+        TypeArrays {
+            mass: types.iter().map(|t| t.mass).collect(),
+            inertia: types
+                .iter()
+                .flat_map(|t| t.inertia.iter().copied())
+                .collect(),
+        }
     }
 }
 
@@ -223,5 +273,21 @@ max = [0.24, 0.04, 0.04]
             }
         }
         assert!(turned > 800, "{turned} turned");
+    }
+
+    /// The closing kick keeps the CPU backend's operations in its order: the same
+    /// bits, frozen particles untouched.
+    #[test]
+    fn the_closing_kick_kernel_gives_the_cpu_backends_bits() {
+        let before = world();
+        let dt = 2e-4;
+        let mut cpu = before.clone();
+        crate::engine::cpu::motion::closing_kick(&mut cpu, dt);
+        let mut kernel = before.clone();
+        HostExecutor { block: 64 }.closing_kick(&mut kernel, dt);
+        let (a, b) = (&cpu.particles, &kernel.particles);
+        assert!(a.velocity == b.velocity && a.angular_momentum == b.angular_momentum);
+        assert!(a.velocity != before.particles.velocity);
+        assert_eq!(a.position, b.position);
     }
 }
