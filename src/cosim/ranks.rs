@@ -23,7 +23,7 @@ use super::CosimError;
 use super::component::Component;
 use crate::Real;
 use crate::analysis::packing::{BedFigures, bed_figures};
-use crate::engine::exchange::{Ranks, broadcast_bytes};
+use crate::engine::exchange::{Exchange, Ranks, broadcast_bytes};
 use crate::scene::{Scene, ShareState, SimState, Simulation, StateReader, StateWriter};
 
 /// What rank 0 reads of the whole run that no rank's share holds, gathered after
@@ -63,11 +63,10 @@ impl Component {
     /// on one rank, rank 0 writing the files, must fail on all, or they would part
     /// ways in the collectives that follow); `failed` in one process.
     pub(super) fn failed_anywhere(&self, failed: bool) -> bool {
-        let Some(ranks) = &self.ranks else {
-            return failed;
-        };
-        let all = ranks.all_to_all_words(vec![vec![failed as u64]; ranks.size()]);
-        all.iter().flatten().any(|&w| w != 0)
+        match &self.ranks {
+            Some(ranks) => ranks.any(failed),
+            None => failed,
+        }
     }
 
     /// The whole run's state made of every rank's `share` (collective on ranks):

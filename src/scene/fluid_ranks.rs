@@ -78,14 +78,7 @@ pub(super) fn update_fluid_on_ranks(share: &dyn Share, world: &mut World) {
     let mut mine: Vec<CellContribution> = all_to_all(share, &outgoing).concat();
     mine.sort_unstable_by_key(|c| (c.cell, c.id));
     let block = blocks.of(share.rank());
-    let mut volume = vec![0.0; block.len()];
-    let mut momentum = vec![Vector3::zeros(); block.len()];
-    for c in &mine {
-        let k = c.cell as usize - block.start;
-        volume[k] += c.volume;
-        momentum[k] += c.momentum;
-    }
-    fluid.set_cell_means(block.start, &volume, &momentum);
+    fluid.add_up(block.clone(), &mine);
     let means: Vec<(Real, Vector3<Real>)> = block
         .clone()
         .map(|c| (fluid.solid_fraction[c], fluid.particle_velocity[c]))
@@ -120,10 +113,10 @@ pub(super) fn whole_exchange(
     }
     let mut all: Vec<SavedFluidParticle> = gathered.into_iter().flatten().collect();
     all.sort_unstable_by_key(|(id, _)| *id);
-    let shares = CellShares::from_rows(
-        all.iter()
-            .filter_map(|(id, (row, _))| Some((*id, row.as_ref()?))),
-    );
+    let shares = CellShares::from_rows(all.iter().filter_map(|(id, (row, _))| {
+        let row = row.as_ref()?;
+        Some((*id, &row.cells[..], &row.volumes[..]))
+    }));
     let exchange = MomentumExchange {
         // Particles inserted since the last force evaluation have no drag: the
         // newest ids, as in one process.

@@ -251,10 +251,10 @@ impl Simulation {
             .map(|i| HeldEnergy::of_particles(world, i..i + 1).total())
             .sum();
         let removed = self.world.particles.remove_where(|i| doomed[i]);
-        if let Some(fluid) = self.world.fluid.as_mut().filter(|_| removed > 0) {
-            fluid.particles_removed(&doomed, &self.world.particles);
-        }
         if removed > 0 {
+            if let Some(fluid) = self.world.fluid.as_mut() {
+                fluid.particles_removed(&doomed, &self.world.particles);
+            }
             self.backend.particles_removed(&self.world);
             self.energy.book_host(-leaving);
         }

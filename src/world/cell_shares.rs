@@ -70,15 +70,16 @@ impl CellShares {
         shares
     }
 
-    /// Shares of the rows `rows` (particle id and row; no id twice), in that order.
-    pub fn from_rows<'a>(rows: impl IntoIterator<Item = (u64, &'a ShareRow)>) -> Self {
+    /// Shares of the rows `rows` (particle id, cells, volumes; no id twice), in
+    /// that order.
+    pub fn from_rows<'a>(rows: impl IntoIterator<Item = (u64, &'a [u32], &'a [Real])>) -> Self {
         let mut shares = CellShares {
             starts: vec![0],
             ..Default::default()
         };
-        for (id, row) in rows {
-            shares.cells.extend_from_slice(&row.cells);
-            shares.volumes.extend_from_slice(&row.volumes);
+        for (id, cells, volumes) in rows {
+            shares.cells.extend_from_slice(cells);
+            shares.volumes.extend_from_slice(volumes);
             shares.starts.push(shares.cells.len() as u32);
             shares.ids.push(id);
         }
@@ -99,15 +100,24 @@ impl CellShares {
     /// Keeps the rows of the particles `ids` (in that order) that have one and
     /// appends `arrived` (rows of particles new to these shares).
     pub fn keep(&self, ids: &[u64], arrived: &[(u64, ShareRow)]) -> Self {
-        let kept: Vec<(u64, ShareRow)> = ids
+        let kept = ids.iter().filter_map(|&id| {
+            let (cells, volumes) = self.row(self.position_of(id)?);
+            Some((id, cells, volumes))
+        });
+        let arrived = arrived
             .iter()
-            .filter_map(|&id| Some((id, self.row_of(id)?)))
-            .collect();
-        Self::from_rows(kept.iter().chain(arrived).map(|(id, row)| (*id, row)))
+            .map(|(id, row)| (*id, &row.cells[..], &row.volumes[..]));
+        Self::from_rows(kept.chain(arrived))
     }
 
     /// Sorts the id index; ids must be unique.
     fn index(&mut self) {
+        self.sort_index();
+        debug_assert!(self.by_id.windows(2).all(|w| w[0].0 < w[1].0));
+    }
+
+    /// `by_id` from `ids`.
+    fn sort_index(&mut self) {
         self.by_id = self
             .ids
             .iter()
@@ -115,7 +125,6 @@ impl CellShares {
             .map(|(r, &id)| (id, r as u32))
             .collect();
         self.by_id.sort_unstable();
-        debug_assert!(self.by_id.windows(2).all(|w| w[0].0 < w[1].0));
     }
 
     fn position_of(&self, id: u64) -> Option<usize> {
@@ -159,19 +168,11 @@ impl CellShares {
             ids,
             by_id: Vec::new(),
         };
-        shares.index_checked()?;
-        Ok(shares)
-    }
-
-    /// [`Self::index`], refusing an id held twice.
-    fn index_checked(&mut self) -> Result<(), String> {
-        let mut sorted = self.ids.clone();
-        sorted.sort_unstable();
-        if let Some(w) = sorted.windows(2).find(|w| w[0] == w[1]) {
-            return Err(format!("fluid cell shares hold particle {} twice", w[0]));
+        shares.sort_index();
+        if let Some(w) = shares.by_id.windows(2).find(|w| w[0].0 == w[1].0) {
+            return Err(format!("fluid cell shares hold particle {} twice", w[0].0));
         }
-        self.index();
-        Ok(())
+        Ok(shares)
     }
 
     /// The parts (for a saved state): starts, cells, volumes, ids.

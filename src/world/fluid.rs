@@ -2,6 +2,8 @@
 //! (velocity, pressure gradient) and what it gets back (solid volume fraction, mean
 //! particle velocity, the momentum the particles took from it).
 
+use std::ops::Range;
+
 use nalgebra::{Point3, Vector3};
 
 use super::{BodyType, CellShares, Particles};
@@ -154,13 +156,8 @@ impl FluidField {
     /// particle order: the same bits on any thread count).
     pub fn update(&mut self, particles: &Particles, types: &[BodyType]) {
         self.shares = CellShares::compute(&self.grid, particles, types);
-        let mut volume = vec![0.0; self.grid.len()];
-        let mut momentum = vec![Vector3::zeros(); self.grid.len()];
-        for c in self.contributions(particles) {
-            volume[c.cell as usize] += c.volume;
-            momentum[c.cell as usize] += c.momentum;
-        }
-        self.set_cell_means(0, &volume, &momentum);
+        let contributions = self.contributions(particles);
+        self.add_up(0..self.grid.len(), &contributions);
     }
 
     /// What each owned particle with a row of the shares brings to each of its
@@ -184,11 +181,17 @@ impl FluidField {
         out
     }
 
-    /// Sets the solid fraction and the mean particle velocity of the cells from
-    /// `first` on, from the sums of the particles' volumes and momenta in them.
-    pub fn set_cell_means(&mut self, first: usize, volume: &[Real], momentum: &[Vector3<Real>]) {
-        for (k, (s, m)) in volume.iter().zip(momentum).enumerate() {
-            let c = first + k;
+    /// Sets the solid fraction and the mean particle velocity of the `cells` from
+    /// `contributions` (all in those cells), each cell's summed in the order given.
+    pub fn add_up(&mut self, cells: Range<usize>, contributions: &[CellContribution]) {
+        let mut volume = vec![0.0; cells.len()];
+        let mut momentum = vec![Vector3::zeros(); cells.len()];
+        for c in contributions {
+            let k = c.cell as usize - cells.start;
+            volume[k] += c.volume;
+            momentum[k] += c.momentum;
+        }
+        for ((c, s), m) in cells.zip(&volume).zip(&momentum) {
             self.solid_fraction[c] = s / self.grid.cell_volume(c);
             self.particle_velocity[c] = if *s > 0.0 { m / *s } else { Vector3::zeros() };
         }

@@ -71,9 +71,9 @@ impl HostExecutor {
     pub fn kick_drift(&self, world: &mut World, dt: Real) {
         let types = TypeArrays::of(world);
         let p = &mut world.particles;
-        let frozen: Vec<u8> = p.frozen.iter().map(|&f| u8::from(f)).collect();
         // nalgebra's points, vectors and quaternions are arrays of doubles (the
-        // quaternion as i, j, k, w), the layout the kernel reads.
+        // quaternion as i, j, k, w), and a bool is a byte of 0 or 1: the layouts the
+        // kernel reads.
         let arrays = [
             p.position.as_mut_ptr().cast(),
             p.velocity.as_mut_ptr().cast(),
@@ -82,7 +82,7 @@ impl HostExecutor {
             p.force.as_ptr().cast_mut().cast(),
             p.torque.as_ptr().cast_mut().cast(),
             p.body_type.as_ptr().cast_mut().cast(),
-            frozen.as_ptr().cast_mut().cast(),
+            p.frozen.as_ptr().cast_mut().cast(),
             types.mass.as_ptr().cast_mut().cast(),
             types.inertia.as_ptr().cast_mut().cast(),
         ];
@@ -96,14 +96,13 @@ impl HostExecutor {
     pub fn closing_kick(&self, world: &mut World, dt: Real) {
         let types = TypeArrays::of(world);
         let p = &mut world.particles;
-        let frozen: Vec<u8> = p.frozen.iter().map(|&f| u8::from(f)).collect();
         let arrays = [
             p.velocity.as_mut_ptr().cast(),
             p.angular_momentum.as_mut_ptr().cast(),
             p.force.as_ptr().cast_mut().cast(),
             p.torque.as_ptr().cast_mut().cast(),
             p.body_type.as_ptr().cast_mut().cast(),
-            frozen.as_ptr().cast_mut().cast(),
+            p.frozen.as_ptr().cast_mut().cast(),
             types.mass.as_ptr().cast_mut().cast(),
         ];
         // SAFETY: the parameters of `closing_kick` in order, as above.
