@@ -1,12 +1,21 @@
 // The kernels compiled for the host executor (src/engine/cuda/host.rs): the
-// thread-local built-ins, the kernels themselves, and for each kernel a trampoline
-// that takes its parameters as cuLaunchKernel does (an array of pointers to each
-// argument), so the executor launches a kernel as the driver would.
+// thread-local built-ins, vec.cuh and the kernels themselves, and for each kernel a
+// trampoline that takes its parameters as cuLaunchKernel does (an array of pointers
+// to each argument), so the executor launches a kernel as the driver would. The
+// trampolines are found by the kernel's name (`talus_host_kernel`).
+#include <cstring>
+#include <utility>
+
 #include "host.h"
 
 thread_local dim3 threadIdx, blockIdx, blockDim, gridDim;
 
+#include "vec.cuh"
+
 #include "integrate.cu"
+#include "list.cu"
+#include "scan.cu"
+#include "spheres.cu"
 
 // Sets the built-ins of the calling thread before it runs one kernel thread.
 extern "C" void talus_host_at(unsigned block, unsigned thread, unsigned block_dim,
@@ -19,21 +28,43 @@ extern "C" void talus_host_at(unsigned block, unsigned thread, unsigned block_di
     blockDim.y = blockDim.z = gridDim.y = gridDim.z = 1;
 }
 
-template <typename T>
-static T arg(void** p, int k) {
-    return *static_cast<T*>(p[k]);
+// Calls `kernel` with the argument each of `p` points to, typed by the kernel's
+// own parameter list.
+template <typename... A, std::size_t... K>
+static void call(void (*kernel)(A...), void** p, std::index_sequence<K...>) {
+    kernel(*static_cast<A*>(p[K])...);
 }
 
-extern "C" void talus_host_closing_kick(void** p) {
-    closing_kick(arg<unsigned>(p, 0), arg<double>(p, 1), arg<double*>(p, 2), arg<double*>(p, 3),
-                 arg<const double*>(p, 4), arg<const double*>(p, 5), arg<const unsigned*>(p, 6),
-                 arg<const unsigned char*>(p, 7), arg<const double*>(p, 8));
+template <typename... A>
+static void call(void (*kernel)(A...), void** p) {
+    call(kernel, p, std::index_sequence_for<A...>{});
 }
 
-extern "C" void talus_host_kick_drift(void** p) {
-    kick_drift(arg<unsigned>(p, 0), arg<double>(p, 1), arg<double*>(p, 2), arg<double*>(p, 3),
-               arg<double*>(p, 4), arg<double*>(p, 5), arg<const double*>(p, 6),
-               arg<const double*>(p, 7), arg<const unsigned*>(p, 8),
-               arg<const unsigned char*>(p, 9), arg<const double*>(p, 10),
-               arg<const double*>(p, 11));
+using Trampoline = void (*)(void**);
+
+struct Entry {
+    const char* name;
+    Trampoline trampoline;
+};
+
+#define KERNEL(name) {#name, [](void** p) { call(name, p); }}
+
+static const Entry kernels[] = {
+    KERNEL(kick_drift),        KERNEL(closing_kick),     KERNEL(bin_particles),
+    KERNEL(scatter_particles), KERNEL(count_partners),   KERNEL(write_partners),
+    KERNEL(count_incident),    KERNEL(fill_incident),    KERNEL(sort_incident),
+    KERNEL(pair_keys),         KERNEL(carry_history),    KERNEL(moved_too_far),
+    KERNEL(copy_doubles),      KERNEL(scan_chunk_totals), KERNEL(scan_chunk_offsets),
+    KERNEL(scan_apply),        KERNEL(zero_words),       KERNEL(copy_words),
+    KERNEL(sphere_contacts),   KERNEL(gather_forces),    KERNEL(count_touching),
+};
+
+// The trampoline of the kernel named `name`, or null.
+extern "C" Trampoline talus_host_kernel(const char* name) {
+    for (const Entry& e : kernels) {
+        if (std::strcmp(e.name, name) == 0) {
+            return e.trampoline;
+        }
+    }
+    return nullptr;
 }

@@ -1,9 +1,9 @@
 // Compiles the CUDA kernels of kernels/*.cu as C++ on the host, for the host
 // executor (src/engine/cuda/host.rs): the built-ins a kernel reads (its thread's
 // and block's indices and the launch's dimensions, thread-local and set by the
-// executor before each thread's call), and the qualifiers and math functions CUDA
-// provides without includes. Kernels use nothing else of CUDA yet (no shared
-// memory, no atomics, no synchronisation within a block).
+// executor before each thread's call), the qualifiers, the math functions CUDA
+// provides without includes, and the atomics the kernels use (relaxed, as CUDA's).
+// Kernels use no shared memory and no synchronisation within a block.
 #pragma once
 
 #include <cmath>
@@ -18,6 +18,15 @@ extern thread_local dim3 threadIdx, blockIdx, blockDim, gridDim;
 #define __device__
 #define __forceinline__ inline
 
+using std::floor;
 using std::fmax;
 using std::fmin;
 using std::sqrt;
+
+static inline unsigned atomicAdd(unsigned* address, unsigned value) {
+    return __atomic_fetch_add(address, value, __ATOMIC_RELAXED);
+}
+
+static inline unsigned atomicOr(unsigned* address, unsigned value) {
+    return __atomic_fetch_or(address, value, __ATOMIC_RELAXED);
+}

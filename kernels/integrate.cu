@@ -7,78 +7,12 @@
 // angular velocity (closed form for an isotropic body, fixed-point iteration to
 // round-off otherwise).
 //
+// The helpers are vec.cuh's.
+//
 // Layout, as the host world holds it: per particle 3 doubles of position,
 // velocity, angular momentum, force and torque; the orientation as a unit
 // quaternion (i, j, k, w); its body type; frozen as a byte (0 or 1). Per body
 // type: the mass and the 3 principal moments of inertia.
-
-struct Vec3 {
-    double x, y, z;
-};
-
-// A quaternion w + x i + y j + z k.
-struct Quat {
-    double w, x, y, z;
-};
-
-static __device__ __forceinline__ Vec3 load3(const double* a, unsigned i) {
-    return Vec3{a[3 * i], a[3 * i + 1], a[3 * i + 2]};
-}
-
-static __device__ __forceinline__ void store3(double* a, unsigned i, Vec3 v) {
-    a[3 * i] = v.x;
-    a[3 * i + 1] = v.y;
-    a[3 * i + 2] = v.z;
-}
-
-static __device__ __forceinline__ Vec3 add(Vec3 a, Vec3 b) {
-    return Vec3{a.x + b.x, a.y + b.y, a.z + b.z};
-}
-
-static __device__ __forceinline__ Vec3 sub(Vec3 a, Vec3 b) {
-    return Vec3{a.x - b.x, a.y - b.y, a.z - b.z};
-}
-
-static __device__ __forceinline__ Vec3 scale(Vec3 a, double s) {
-    return Vec3{a.x * s, a.y * s, a.z * s};
-}
-
-static __device__ __forceinline__ Vec3 mul(Vec3 a, Vec3 b) {
-    return Vec3{a.x * b.x, a.y * b.y, a.z * b.z};
-}
-
-static __device__ __forceinline__ Vec3 cross(Vec3 a, Vec3 b) {
-    return Vec3{a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
-}
-
-static __device__ __forceinline__ double norm(Vec3 a) {
-    return sqrt(a.x * a.x + a.y * a.y + a.z * a.z);
-}
-
-static __device__ __forceinline__ Quat qmul(Quat a, Quat b) {
-    return Quat{
-        a.w * b.w - a.x * b.x - a.y * b.y - a.z * b.z,
-        a.w * b.x + a.x * b.w + a.y * b.z - a.z * b.y,
-        a.w * b.y - a.x * b.z + a.y * b.w + a.z * b.x,
-        a.w * b.z + a.x * b.y - a.y * b.x + a.z * b.w,
-    };
-}
-
-static __device__ __forceinline__ Quat normalised(Quat q) {
-    double s = 1.0 / sqrt(q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z);
-    return Quat{q.w * s, q.x * s, q.y * s, q.z * s};
-}
-
-// v turned by the unit quaternion q: v + 2 w (u × v) + 2 u × (u × v), u = (x, y, z).
-static __device__ __forceinline__ Vec3 rotate(Quat q, Vec3 v) {
-    Vec3 u = Vec3{q.x, q.y, q.z};
-    Vec3 t = scale(cross(u, v), 2.0);
-    return add(add(v, scale(t, q.w)), cross(u, t));
-}
-
-static __device__ __forceinline__ Quat conjugate(Quat q) {
-    return Quat{q.w, -q.x, -q.y, -q.z};
-}
 
 // C^T v for the Cayley rotation of w: v turned back by the unit quaternion (1, w)/|.|.
 static __device__ __forceinline__ Vec3 cayley_transpose(Vec3 w, Vec3 v) {
@@ -95,7 +29,8 @@ static __device__ void free_rotation(Quat* q, Vec3* l, Vec3 inertia, double dt) 
         Vec3 w = scale(*l, 0.5 * dt / inertia.x);
         Quat turned = qmul(Quat{0.0, w.x, w.y, w.z}, *q);
         turned = Quat{q->w + turned.w, q->x + turned.x, q->y + turned.y, q->z + turned.z};
-        *q = normalised(turned);
+        double s = 1.0 / qnorm(turned);
+        *q = Quat{turned.w * s, turned.x * s, turned.y * s, turned.z * s};
         return;
     }
     Vec3 l0 = rotate(conjugate(*q), *l);

@@ -5,8 +5,8 @@
 //! `nvidia-cuda-nvrtc-cu12`.
 #![cfg(feature = "cuda")]
 
-use talus::engine::cuda::Kernel;
 use talus::engine::cuda::nvrtc::{ARCHITECTURES, NvrtcError, compile, compile_source, is_present};
+use talus::engine::cuda::{FILES, Kernel};
 
 #[test]
 fn every_kernel_compiles_with_nvrtc_for_every_architecture() {
@@ -19,22 +19,37 @@ fn every_kernel_compiles_with_nvrtc_for_every_architecture() {
         eprintln!("skipped: {}", NvrtcError::Missing);
         return;
     }
-    for kernel in Kernel::ALL {
+    for file in &FILES {
         for arch in ARCHITECTURES {
-            let ptx = compile(kernel, arch).unwrap_or_else(|e| panic!("{e}"));
+            let ptx = compile(file, arch).unwrap_or_else(|e| panic!("{e}"));
             assert!(ptx.contains(&format!(".target {arch}")), "{arch}");
-            assert!(
-                ptx.contains(&format!(".entry {}(", kernel.name())),
-                "{} in {arch}'s PTX",
-                kernel.name()
-            );
+            let kernels = Kernel::ALL
+                .into_iter()
+                .filter(|k| k.file().name == file.name);
+            for kernel in kernels {
+                assert!(
+                    ptx.contains(&format!(".entry {}(", kernel.name())),
+                    "{} in {arch}'s PTX of {}",
+                    kernel.name(),
+                    file.name
+                );
+            }
         }
     }
+    // Every kernel belongs to a file that was compiled.
+    assert!(
+        Kernel::ALL
+            .iter()
+            .all(|k| FILES.iter().any(|f| k.file().name == f.name))
+    );
     let broken = "extern \"C\" __global__ void k(double* x) { x[0] = undeclared; }";
     let err = compile_source("broken.cu", broken, "sm_80").unwrap_err();
     let said = err.to_string();
+    // The message names the file and its own line (after the prepended helpers).
     assert!(
-        said.starts_with("kernels/broken.cu: NVRTC for sm_80: ") && said.contains("undeclared"),
+        said.starts_with("kernels/broken.cu: NVRTC for sm_80: ")
+            && said.contains("undeclared")
+            && said.contains("broken.cu(1)"),
         "{said}"
     );
 }

@@ -4,51 +4,169 @@
 //! launches them as the driver does (blocks of threads, the parameters as an array
 //! of pointers), the blocks in parallel.
 //!
-//! What exists: the kernels of the opening kick and drift ([`Kernel::KickDrift`])
-//! and of the closing kick ([`Kernel::ClosingKick`]), checked against the CPU
-//! backend's stages through the host executor, and every
-//! kernel compiled by NVRTC for [`nvrtc::ARCHITECTURES`]. The rest of the step, the
-//! driver device and the backend behind the seam are to come.
+//! A [`device::Device`] holds buffers and launches kernels: the CUDA driver
+//! ([`driver::CudaDevice`]) or the host executor ([`device::HostDevice`]), behind
+//! one interface, so the code that drives the kernels is the same on both.
+//! [`spheres::DeviceSpheres`] steps a world of Hertz–Mindlin spheres on a device:
+//! integration, the candidate list (a hashed cell grid, pairs by prefix sum), the
+//! pair contacts with their tangential history, and the gather; it gives the CPU
+//! backend's bits through the host executor. Walls, polyhedra, the backend behind
+//! the seam and multi-GPU are to come.
 
+pub mod device;
+mod device_list;
+pub mod driver;
 pub mod host;
 pub mod nvrtc;
+pub mod spheres;
+
+/// A source file of `kernels/`.
+#[derive(Debug)]
+pub struct KernelFile {
+    /// Its name in `kernels/`.
+    pub name: &'static str,
+    /// Its text.
+    pub source: &'static str,
+}
+
+/// The helpers every kernel file is compiled after.
+pub const HELPERS: KernelFile = KernelFile {
+    name: "vec.cuh",
+    source: include_str!("../../../kernels/vec.cuh"),
+};
+
+/// The kernel files, each compiled to one module.
+pub static FILES: [KernelFile; 4] = [
+    KernelFile {
+        name: "integrate.cu",
+        source: include_str!("../../../kernels/integrate.cu"),
+    },
+    KernelFile {
+        name: "list.cu",
+        source: include_str!("../../../kernels/list.cu"),
+    },
+    KernelFile {
+        name: "scan.cu",
+        source: include_str!("../../../kernels/scan.cu"),
+    },
+    KernelFile {
+        name: "spheres.cu",
+        source: include_str!("../../../kernels/spheres.cu"),
+    },
+];
 
 /// A kernel of `kernels/`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Kernel {
-    /// `kick_drift` of `integrate.cu`: the opening kick and drift of the owned
-    /// particles, one thread per particle.
+    /// The opening kick and drift of the owned particles (`integrate.cu`).
     KickDrift,
-    /// `closing_kick` of `integrate.cu`: the closing half kick of the owned
-    /// particles, one thread per particle.
+    /// The closing half kick of the owned particles (`integrate.cu`).
     ClosingKick,
+    /// Each particle's bucket of the hashed grid, counted (`list.cu`).
+    BinParticles,
+    /// Each particle into its bucket's slice (`list.cu`).
+    ScatterParticles,
+    /// Each particle's partners of higher index, counted (`list.cu`).
+    CountPartners,
+    /// Each particle's pairs, sorted (`list.cu`).
+    WritePartners,
+    /// The pairs holding each particle, counted (`list.cu`).
+    CountIncident,
+    /// The pairs holding each particle, written (`list.cu`).
+    FillIncident,
+    /// Each particle's incidences, sorted (`list.cu`).
+    SortIncident,
+    /// The ids of each pair (`list.cu`).
+    PairKeys,
+    /// Tangential history carried from the old list to the new (`list.cu`).
+    CarryHistory,
+    /// Whether any particle moved half a skin since the build (`list.cu`).
+    MovedTooFar,
+    /// A copy of doubles (`list.cu`).
+    CopyDoubles,
+    /// The prefix sum's chunk totals (`scan.cu`).
+    ScanChunkTotals,
+    /// The prefix sum's chunk offsets (`scan.cu`).
+    ScanChunkOffsets,
+    /// The prefix sum's last pass (`scan.cu`).
+    ScanApply,
+    /// Words set to zero (`scan.cu`).
+    ZeroWords,
+    /// A copy of words (`scan.cu`).
+    CopyWords,
+    /// The Hertz–Mindlin contacts of sphere pairs (`spheres.cu`).
+    SphereContacts,
+    /// Each particle's weight and pair forces (`spheres.cu`).
+    GatherForces,
+    /// The pairs that touch, counted (`spheres.cu`).
+    CountTouching,
 }
 
 impl Kernel {
     /// Every kernel.
-    pub const ALL: [Kernel; 2] = [Kernel::KickDrift, Kernel::ClosingKick];
+    pub const ALL: [Kernel; 21] = [
+        Kernel::KickDrift,
+        Kernel::ClosingKick,
+        Kernel::BinParticles,
+        Kernel::ScatterParticles,
+        Kernel::CountPartners,
+        Kernel::WritePartners,
+        Kernel::CountIncident,
+        Kernel::FillIncident,
+        Kernel::SortIncident,
+        Kernel::PairKeys,
+        Kernel::CarryHistory,
+        Kernel::MovedTooFar,
+        Kernel::CopyDoubles,
+        Kernel::ScanChunkTotals,
+        Kernel::ScanChunkOffsets,
+        Kernel::ScanApply,
+        Kernel::ZeroWords,
+        Kernel::CopyWords,
+        Kernel::SphereContacts,
+        Kernel::GatherForces,
+        Kernel::CountTouching,
+    ];
 
     /// Its name in the source (`extern "C"`, so the PTX entry has it too).
     pub fn name(self) -> &'static str {
         match self {
             Kernel::KickDrift => "kick_drift",
             Kernel::ClosingKick => "closing_kick",
+            Kernel::BinParticles => "bin_particles",
+            Kernel::ScatterParticles => "scatter_particles",
+            Kernel::CountPartners => "count_partners",
+            Kernel::WritePartners => "write_partners",
+            Kernel::CountIncident => "count_incident",
+            Kernel::FillIncident => "fill_incident",
+            Kernel::SortIncident => "sort_incident",
+            Kernel::PairKeys => "pair_keys",
+            Kernel::CarryHistory => "carry_history",
+            Kernel::MovedTooFar => "moved_too_far",
+            Kernel::CopyDoubles => "copy_doubles",
+            Kernel::ScanChunkTotals => "scan_chunk_totals",
+            Kernel::ScanChunkOffsets => "scan_chunk_offsets",
+            Kernel::ScanApply => "scan_apply",
+            Kernel::ZeroWords => "zero_words",
+            Kernel::CopyWords => "copy_words",
+            Kernel::SphereContacts => "sphere_contacts",
+            Kernel::GatherForces => "gather_forces",
+            Kernel::CountTouching => "count_touching",
         }
     }
 
-    /// The source file in `kernels/` that holds it.
-    pub fn file(self) -> &'static str {
-        match self {
-            Kernel::KickDrift | Kernel::ClosingKick => "integrate.cu",
-        }
-    }
-
-    /// The text of its source file.
-    pub fn source(self) -> &'static str {
-        match self {
-            Kernel::KickDrift | Kernel::ClosingKick => {
-                include_str!("../../../kernels/integrate.cu")
+    /// The source file that holds it.
+    pub fn file(self) -> &'static KernelFile {
+        use Kernel::*;
+        let index = match self {
+            KickDrift | ClosingKick => 0,
+            BinParticles | ScatterParticles | CountPartners | WritePartners | CountIncident
+            | FillIncident | SortIncident | PairKeys | CarryHistory | MovedTooFar | CopyDoubles => {
+                1
             }
-        }
+            ScanChunkTotals | ScanChunkOffsets | ScanApply | ZeroWords | CopyWords => 2,
+            SphereContacts | GatherForces | CountTouching => 3,
+        };
+        &FILES[index]
     }
 }

@@ -2,7 +2,7 @@
 //! `libnvrtc` at run time (the CUDA toolkit's, or PyPI's `nvidia-cuda-nvrtc-cu12`
 //! with its `lib` directory on `LD_LIBRARY_PATH`).
 
-use super::Kernel;
+use super::{HELPERS, KernelFile};
 
 /// The GPU architectures every kernel is compiled for: Ampere (A100) and Hopper
 /// (H100, H200).
@@ -23,7 +23,7 @@ pub enum NvrtcError {
         /// The source file.
         file: &'static str,
         /// The architecture.
-        arch: &'static str,
+        arch: String,
         /// What NVRTC said.
         log: String,
     },
@@ -35,34 +35,35 @@ pub fn is_present() -> bool {
     unsafe { cudarc::nvrtc::sys::is_culib_present() }
 }
 
-/// `kernel`'s source compiled to PTX for `arch` (one of [`ARCHITECTURES`]), in
-/// double precision with IEEE division and square roots.
-pub fn compile(kernel: Kernel, arch: &'static str) -> Result<String, NvrtcError> {
-    compile_source(kernel.file(), kernel.source(), arch)
+/// The kernel file compiled to PTX for `arch` (`"sm_80"`, `"sm_90"`, ...).
+pub fn compile(file: &KernelFile, arch: &str) -> Result<String, NvrtcError> {
+    compile_source(file.name, file.source, arch)
 }
 
-/// [`compile`] of the text `source` of the file `file`.
-pub fn compile_source(
-    file: &'static str,
-    source: &str,
-    arch: &'static str,
-) -> Result<String, NvrtcError> {
+/// [`compile`] of the text `source` of the file `file`: after [`HELPERS`], in double
+/// precision with IEEE division and square roots and without contraction into fused
+/// multiply–adds (so a kernel computes what the CPU backend computes, operation by
+/// operation).
+pub fn compile_source(file: &'static str, source: &str, arch: &str) -> Result<String, NvrtcError> {
     if !is_present() {
         return Err(NvrtcError::Missing);
     }
     let options = cudarc::nvrtc::CompileOptions {
-        arch: Some(arch),
         prec_div: Some(true),
         prec_sqrt: Some(true),
         ftz: Some(false),
+        fmad: Some(false),
         name: Some(file.into()),
+        options: vec![format!("--gpu-architecture={arch}")],
         ..Default::default()
     };
-    cudarc::nvrtc::compile_ptx_with_opts(source, options)
+    // `#line` keeps NVRTC's messages at the file's own lines.
+    let text = format!("{}\n#line 1 \"{file}\"\n{source}", HELPERS.source);
+    cudarc::nvrtc::compile_ptx_with_opts(text, options)
         .map(|ptx| ptx.to_src())
         .map_err(|e| NvrtcError::Compile {
             file,
-            arch,
+            arch: arch.to_owned(),
             log: match e {
                 cudarc::nvrtc::CompileError::CompileError { log, .. } => {
                     log.to_string_lossy().into_owned()

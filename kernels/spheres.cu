@@ -1,0 +1,191 @@
+// The Hertz–Mindlin contacts of a world of spheres (engine/cpu/hertz.rs,
+// contact/hertz_mindlin.rs, contact/tangential.rs, engine/cpu/forces.rs) and the
+// gather of every particle's forces (engine/cpu/pairs.rs): the CPU backend's
+// operations in its order, so the same bits.
+//
+// Layouts: per body type its radius, 1/m, 1/I, m and material; per pair of
+// materials (row-major) E*, G*, β, √(4G*/E*) and the friction coefficient; per pair
+// its tangential history (spring, 3 doubles, and the stiffness it was stretched at)
+// and its result (force on the second particle, torque on the first and on the
+// second, elastic energy, energy dissipated: 11 doubles) and whether it touches.
+
+#define HISTORY_DOUBLES 4u
+#define RESULT_DOUBLES 11u
+#define MATERIAL_DOUBLES 5u
+
+// 2 √(5/6), the factor of the damping coefficients.
+#define DAMPING_FACTOR 1.8257418583505537
+
+struct Spring {
+    Vec3 spring;
+    double stiffness;
+};
+
+static __device__ __forceinline__ double spring_energy(Spring s) {
+    return 0.5 * s.stiffness * norm_squared(s.spring);
+}
+
+// Cundall–Strack friction (contact/tangential.rs): the force on body 2, the spring
+// kept in *kept.
+static __device__ __forceinline__ Vec3 tangential_force(Spring history, Vec3 normal,
+                                                        Vec3 relative_velocity, double dt,
+                                                        double stiffness, double damping,
+                                                        double limit, Spring* kept) {
+    Vec3 previous = history.spring;
+    Vec3 spring = sub(previous, scale(normal, dot(normal, previous)));
+    double projected = norm_squared(spring);
+    if (projected > 0.0) {
+        double keep = history.stiffness > 0.0 && stiffness > history.stiffness
+                          ? history.stiffness / stiffness
+                          : 1.0;
+        spring = scale(spring, keep * sqrt(norm_squared(previous) / projected));
+    }
+    Vec3 vt = sub(relative_velocity, scale(normal, dot(normal, relative_velocity)));
+    spring = add(spring, scale(vt, dt));
+    Vec3 trial = sub(scale(spring, -stiffness), scale(vt, damping));
+    double squared = norm_squared(trial);
+    if (squared <= limit * limit || squared == 0.0) {
+        *kept = Spring{spring, stiffness};
+        return trial;
+    }
+    double magnitude = sqrt(squared);
+    Vec3 force = scale(trial, limit / magnitude);
+    double length = norm(spring);
+    if (stiffness > 0.0 && stiffness * length > limit) {
+        spring = scale(spring, limit / (stiffness * length));
+    }
+    *kept = Spring{spring, stiffness};
+    return force;
+}
+
+// One thread per candidate pair: its contact, if the spheres overlap and one of
+// them moves, into its result; its history replaced by what the contact leaves
+// (none when apart).
+extern "C" __global__ void sphere_contacts(
+    unsigned pair_count, double dt, const unsigned* pairs, const double* position,
+    const double* velocity, const double* angular_momentum, const unsigned* body_type,
+    const unsigned char* frozen, const double* type_radius, const double* type_inverse_mass,
+    const double* type_inverse_inertia, const unsigned* type_material, unsigned materials,
+    const double* material_pairs, double* history, double* results, unsigned char* touching) {
+    unsigned e = blockIdx.x * blockDim.x + threadIdx.x;
+    if (e >= pair_count) {
+        return;
+    }
+    unsigned i = pairs[2 * e], j = pairs[2 * e + 1];
+    unsigned ti = body_type[i], tj = body_type[j];
+    double ra = type_radius[ti], rb = type_radius[tj];
+    Spring before = Spring{load3(history + HISTORY_DOUBLES * e, 0),
+                           history[HISTORY_DOUBLES * e + 3]};
+    double* result = results + RESULT_DOUBLES * e;
+    Vec3 xi = load3(position, i), xj = load3(position, j);
+    Vec3 d = sub(xj, xi);
+    double distance_squared = norm_squared(d);
+    double reach = ra + rb;
+    bool contact = !(frozen[i] && frozen[j]) && distance_squared < reach * reach &&
+                   distance_squared != 0.0;
+    if (!contact) {
+        bool held = before.spring.x != 0.0 || before.spring.y != 0.0 || before.spring.z != 0.0;
+        for (unsigned k = 0; k < RESULT_DOUBLES; ++k) {
+            result[k] = 0.0;
+        }
+        touching[e] = 0;
+        if (held) {
+            // The friction spring's energy is let go with the contact.
+            result[10] = spring_energy(before);
+            for (unsigned k = 0; k < HISTORY_DOUBLES; ++k) {
+                history[HISTORY_DOUBLES * e + k] = 0.0;
+            }
+        }
+        return;
+    }
+    double distance = sqrt(distance_squared);
+    Vec3 normal = scale(d, 1.0 / distance);
+    double depth = reach - distance;
+    Vec3 lever_i = scale(normal, ra - 0.5 * depth);
+    Vec3 lever_j = scale(normal, -(rb - 0.5 * depth));
+    Vec3 wi = scale(load3(angular_momentum, i), type_inverse_inertia[ti]);
+    Vec3 wj = scale(load3(angular_momentum, j), type_inverse_inertia[tj]);
+    Vec3 relative = sub(sub(add(load3(velocity, j), cross(wj, lever_j)), load3(velocity, i)),
+                        cross(wi, lever_i));
+    Vec3 spin = sub(wj, wi);
+    double inverse_mass = type_inverse_mass[ti] + type_inverse_mass[tj];
+    const double* m =
+        material_pairs + MATERIAL_DOUBLES * (type_material[ti] * materials + type_material[tj]);
+    double young = m[0], shear = m[1], beta = m[2], damping_ratio = m[3], friction = m[4];
+
+    // Hertz–Mindlin (contact/hertz_mindlin.rs).
+    double radius = ra * rb / (ra + rb);
+    double mass = 1.0 / inverse_mass;
+    double a = sqrt(radius * depth);
+    double tangent = 2.0 * young * a;
+    double stiffness = (2.0 / 3.0) * tangent;
+    double elastic = stiffness * depth;
+    double damping_n = -DAMPING_FACTOR * beta * sqrt(tangent * mass);
+    double vn = dot(relative, normal);
+    double normal_force = fmax(elastic - damping_n * vn, 0.0);
+    double kt = 8.0 * shear * a;
+    double damping_t = damping_n * damping_ratio;
+    Spring kept;
+    Vec3 t = tangential_force(before, normal, relative, dt, kt, damping_t, friction * normal_force,
+                              &kept);
+    Vec3 force = add(scale(normal, normal_force), t);
+    Vec3 torque = cross(lever_j, force);
+    double energy = 0.4 * elastic * depth + spring_energy(kept);
+
+    // Energy dissipated over the step (engine/cpu/forces.rs `dissipated`): the work
+    // of the force less its elastic normal part at the step's end velocity.
+    Vec3 damping = sub(force, scale(normal, elastic));
+    Vec3 moved = add(relative, scale(force, 0.5 * dt * inverse_mass));
+    double dissipated = -dt * (dot(damping, moved) + dot(Vec3{0.0, 0.0, 0.0}, spin)) -
+                        (spring_energy(kept) - spring_energy(before));
+
+    Vec3 reaction = scale(add(torque, cross(sub(xj, xi), force)), -1.0);
+    store3(result, 0, force);
+    store3(result, 1, reaction);
+    store3(result, 2, torque);
+    result[9] = energy;
+    result[10] = dissipated;
+    touching[e] = 1;
+    history[HISTORY_DOUBLES * e] = kept.spring.x;
+    history[HISTORY_DOUBLES * e + 1] = kept.spring.y;
+    history[HISTORY_DOUBLES * e + 2] = kept.spring.z;
+    history[HISTORY_DOUBLES * e + 3] = kept.stiffness;
+}
+
+// One thread per particle: its weight plus its pairs' forces in pair order (its
+// partners in the order of their ids), and the torques; whether it touches.
+extern "C" __global__ void gather_forces(
+    unsigned n, double gx, double gy, double gz, const unsigned* body_type,
+    const double* type_mass, const unsigned char* frozen, const unsigned* incident_starts,
+    const unsigned* incident, const double* results, const unsigned char* pair_touching,
+    double* force, double* torque, unsigned char* touching) {
+    unsigned k = blockIdx.x * blockDim.x + threadIdx.x;
+    if (k >= n) {
+        return;
+    }
+    Vec3 f = scale(Vec3{gx, gy, gz}, type_mass[body_type[k]]);
+    Vec3 t = Vec3{0.0, 0.0, 0.0};
+    unsigned char touches = frozen[k];
+    for (unsigned s = incident_starts[k]; s < incident_starts[k + 1]; ++s) {
+        unsigned entry = incident[s];
+        unsigned e = entry & 0x7fffffffu;
+        bool first = (entry & 0x80000000u) != 0;
+        const double* c = results + RESULT_DOUBLES * e;
+        double sign = first ? -1.0 : 1.0;
+        touches |= pair_touching[e];
+        f = add(f, scale(load3(c, 0), sign));
+        t = add(t, load3(c, first ? 1 : 2));
+    }
+    store3(force, k, f);
+    store3(torque, k, t);
+    touching[k] = touches;
+}
+
+// One thread per pair: counts the pairs that touch (*count zeroed before).
+extern "C" __global__ void count_touching(unsigned pair_count, const unsigned char* touching,
+                                          unsigned* count) {
+    unsigned e = blockIdx.x * blockDim.x + threadIdx.x;
+    if (e < pair_count && touching[e]) {
+        atomicAdd(count, 1u);
+    }
+}

@@ -1,0 +1,485 @@
+//! A world of Hertz–Mindlin spheres stepped on a [`Device`]: the CPU backend's step
+//! (`engine/cpu`) with every stage a kernel and the state in device memory between
+//! steps. Through the host executor it gives the CPU backend's bits
+//! (`tests/cuda_spheres.rs`).
+//!
+//! A step is [`DeviceSpheres::step`]: the opening kick and drift, then the force
+//! evaluation (the list checked and rebuilt with its history carried, the pair
+//! contacts, the gather), then the closing kick. Per step the host reads back one
+//! word (whether the list is stale) and, when it was rebuilt, the pair count; the
+//! particles come back by [`DeviceSpheres::download`].
+//!
+//! What it does not take yet (refused by [`DeviceSpheres::new`]): walls, polyhedra,
+//! rolling resistance, a fluid, ghosts of a decomposition, particles not stored in
+//! the order of their ids.
+
+use nalgebra::{Point3, Quaternion, UnitQuaternion, Vector3};
+
+use super::Kernel;
+use super::device::{Arg, Array, Device, DeviceError};
+use super::device_list::{DeviceList, ListInputs, run};
+use crate::Real;
+use crate::contact::{RollingModel, TangentialHistory, pair_restitution};
+use crate::engine::backend::ContactHistory;
+use crate::engine::neighbours::automatic_skin;
+use crate::engine::{RoundLaw, StepParams};
+use crate::world::World;
+
+/// Doubles of a pair's tangential history on the device: the spring and the
+/// stiffness it was stretched at.
+const HISTORY: usize = 4;
+/// Doubles of a pair's result (`kernels/spheres.cu`).
+const RESULT: usize = 11;
+
+/// Why a world cannot be stepped on the device.
+#[derive(Debug, thiserror::Error)]
+pub enum SpheresError {
+    /// The world holds something the device stepper does not model yet.
+    #[error("the cuda backend does not yet step {0}")]
+    Unsupported(String),
+    /// A device call failed.
+    #[error(transparent)]
+    Device(#[from] DeviceError),
+}
+
+/// Per body type and per pair of materials, what the kernels read.
+#[derive(Debug, Default)]
+struct TypeArrays {
+    mass: Array<Real>,
+    inertia: Array<Real>,
+    radius: Array<Real>,
+    inverse_mass: Array<Real>,
+    inverse_inertia: Array<Real>,
+    material: Array<u32>,
+    /// Row-major over (material 1, material 2): E*, G*, β, √(4G*/E*), μ.
+    material_pairs: Array<Real>,
+    materials: u32,
+}
+
+/// The particles' state on the device (nalgebra's layouts: 3 doubles per point or
+/// vector, a quaternion as i, j, k, w; frozen as a byte).
+#[derive(Debug, Default)]
+struct ParticleArrays {
+    position: Array<Real>,
+    velocity: Array<Real>,
+    orientation: Array<Real>,
+    angular_momentum: Array<Real>,
+    force: Array<Real>,
+    torque: Array<Real>,
+    body_type: Array<u32>,
+    frozen: Array<u8>,
+    id: Array<u64>,
+    touching: Array<u8>,
+}
+
+/// What the pair stage keeps and writes, aligned with the list's pairs.
+#[derive(Debug, Default)]
+struct PairArrays {
+    history: Array<Real>,
+    old_history: Array<Real>,
+    results: Array<Real>,
+    touching: Array<u8>,
+    counter: Array<u32>,
+}
+
+/// A world of spheres on a device (see the module).
+#[derive(Debug)]
+pub struct DeviceSpheres {
+    device: Box<dyn Device>,
+    n: usize,
+    gravity: Vector3<Real>,
+    time: Real,
+    types: TypeArrays,
+    particles: ParticleArrays,
+    pairs: PairArrays,
+    list: DeviceList,
+    /// Pairs that touched at the last force evaluation.
+    contacts: usize,
+}
+
+fn flat<const K: usize, T: Copy>(items: impl Iterator<Item = [T; K]>) -> Vec<T> {
+    items.flatten().collect()
+}
+
+fn vectors(v: &[Vector3<Real>]) -> Vec<Real> {
+    flat(v.iter().map(|x| [x.x, x.y, x.z]))
+}
+
+impl DeviceSpheres {
+    /// Uploads `world` to `device`, checking that it holds only what the device
+    /// stepper models (see the module).
+    pub fn new(
+        mut device: Box<dyn Device>,
+        world: &World,
+        params: &StepParams,
+    ) -> Result<Self, SpheresError> {
+        let unsupported = |what: &str| Err(SpheresError::Unsupported(what.into()));
+        if params.round_law
+            != (RoundLaw::HertzMindlin {
+                rolling: RollingModel::None,
+            })
+        {
+            return unsupported("a law other than Hertz–Mindlin without rolling resistance");
+        }
+        if !world.walls.is_empty() {
+            return unsupported("walls");
+        }
+        if world.fluid.is_some() {
+            return unsupported("a fluid");
+        }
+        let p = &world.particles;
+        if p.ghosts() > 0 {
+            return unsupported("a rank's share of a decomposed world");
+        }
+        if !p.id.is_sorted() {
+            return unsupported("particles out of the order of their ids");
+        }
+        let mut radii = Vec::new();
+        for t in &world.body_types {
+            match t.shape.as_sphere() {
+                Some(s) => radii.push(s.radius),
+                None => return unsupported("polyhedra"),
+            }
+        }
+        let d = device.as_mut();
+        let mut types = TypeArrays::default();
+        let bodies = &world.body_types;
+        types
+            .mass
+            .write(d, &bodies.iter().map(|t| t.mass).collect::<Vec<_>>())?;
+        types.inertia.write(
+            d,
+            &vectors(&bodies.iter().map(|t| t.inertia).collect::<Vec<_>>()),
+        )?;
+        types.radius.write(d, &radii)?;
+        types
+            .inverse_mass
+            .write(d, &bodies.iter().map(|t| 1.0 / t.mass).collect::<Vec<_>>())?;
+        types.inverse_inertia.write(
+            d,
+            &bodies.iter().map(|t| 1.0 / t.inertia.x).collect::<Vec<_>>(),
+        )?;
+        types.material.write(
+            d,
+            &bodies.iter().map(|t| t.material as u32).collect::<Vec<_>>(),
+        )?;
+        // The rows of `engine::laws::ContactLaws::prepare`, by the same operations.
+        let mut rows = Vec::new();
+        for a in &world.materials {
+            for b in &world.materials {
+                let e = pair_restitution(a.restitution, b.restitution);
+                let h = crate::contact::HertzMindlinPair::new(a, b, e);
+                rows.extend([
+                    h.young,
+                    h.shear,
+                    h.beta,
+                    h.damping_ratio,
+                    0.5 * (a.friction + b.friction),
+                ]);
+            }
+        }
+        types.material_pairs.write(d, &rows)?;
+        types.materials = world.materials.len() as u32;
+
+        let all_radii: Vec<Real> = p.body_type.iter().map(|&k| radii[k as usize]).collect();
+        let skin = params.skin.unwrap_or_else(|| automatic_skin(&all_radii));
+        let skin = if skin.is_finite() { skin.max(0.0) } else { 0.0 };
+        let largest = radii.iter().copied().fold(0.0, Real::max);
+        let list = DeviceList::new(skin, 2.0 * largest + skin);
+        let mut spheres = DeviceSpheres {
+            device,
+            n: p.len(),
+            gravity: world.gravity,
+            time: world.time,
+            types,
+            particles: ParticleArrays::default(),
+            pairs: PairArrays::default(),
+            list,
+            contacts: 0,
+        };
+        spheres.upload_particles(world)?;
+        Ok(spheres)
+    }
+
+    /// Copies the particles' state to the device.
+    fn upload_particles(&mut self, world: &World) -> Result<(), DeviceError> {
+        let (d, a, p) = (self.device.as_mut(), &mut self.particles, &world.particles);
+        a.position
+            .write(d, &flat(p.position.iter().map(|x| [x.x, x.y, x.z])))?;
+        a.velocity.write(d, &vectors(&p.velocity))?;
+        a.orientation
+            .write(d, &flat(p.orientation.iter().map(|q| q.coords.into())))?;
+        a.angular_momentum.write(d, &vectors(&p.angular_momentum))?;
+        a.force.write(d, &vectors(&p.force))?;
+        a.torque.write(d, &vectors(&p.torque))?;
+        a.body_type.write(d, &p.body_type)?;
+        a.frozen.write(
+            d,
+            &p.frozen.iter().map(|&f| u8::from(f)).collect::<Vec<_>>(),
+        )?;
+        a.id.write(d, &p.id)?;
+        a.touching.resize(d, p.len())?;
+        self.list.invalidate();
+        Ok(())
+    }
+
+    /// What the device is.
+    pub fn device(&self) -> String {
+        self.device.description()
+    }
+
+    /// Pairs that touched at the last force evaluation.
+    pub fn contacts(&self) -> usize {
+        self.contacts
+    }
+
+    /// Candidate pairs of the list.
+    pub fn candidate_pairs(&self) -> usize {
+        self.list.pair_count
+    }
+
+    /// List builds so far.
+    pub fn list_builds(&self) -> u64 {
+        self.list.builds
+    }
+
+    /// Evaluates the forces of the state as it is (before the first step).
+    pub fn initialise(&mut self, dt: Real) -> Result<(), DeviceError> {
+        self.forces(dt)
+    }
+
+    /// One velocity-Verlet step of length `dt`: the stages in order.
+    pub fn step(&mut self, dt: Real) -> Result<(), DeviceError> {
+        let (d, p, t) = (self.device.as_mut(), &self.particles, &self.types);
+        let n = Arg::U32(self.n as u32);
+        // SAFETY: the parameters of kick_drift, each array sized for n particles or
+        // the body types (integrate.cu).
+        unsafe {
+            run(
+                d,
+                Kernel::KickDrift,
+                self.n,
+                &[
+                    n,
+                    Arg::F64(dt),
+                    p.position.arg(),
+                    p.velocity.arg(),
+                    p.orientation.arg(),
+                    p.angular_momentum.arg(),
+                    p.force.arg(),
+                    p.torque.arg(),
+                    p.body_type.arg(),
+                    p.frozen.arg(),
+                    t.mass.arg(),
+                    t.inertia.arg(),
+                ],
+            )?;
+        }
+        self.time += dt;
+        self.forces(dt)?;
+        let (d, p, t) = (self.device.as_mut(), &self.particles, &self.types);
+        // SAFETY: as above, closing_kick's parameters.
+        unsafe {
+            run(
+                d,
+                Kernel::ClosingKick,
+                self.n,
+                &[
+                    n,
+                    Arg::F64(dt),
+                    p.velocity.arg(),
+                    p.angular_momentum.arg(),
+                    p.force.arg(),
+                    p.torque.arg(),
+                    p.body_type.arg(),
+                    p.frozen.arg(),
+                    t.mass.arg(),
+                ],
+            )
+        }
+    }
+
+    /// The force evaluation: the list brought up to date, the pair contacts, the
+    /// gather.
+    fn forces(&mut self, dt: Real) -> Result<(), DeviceError> {
+        let d = self.device.as_mut();
+        let (p, t, pairs, list) = (
+            &self.particles,
+            &self.types,
+            &mut self.pairs,
+            &mut self.list,
+        );
+        if list.is_stale(d, self.n, &p.position)? {
+            let inputs = ListInputs {
+                n: self.n,
+                position: &p.position,
+                body_type: &p.body_type,
+                id: &p.id,
+                type_radius: &t.radius,
+            };
+            list.build(d, &inputs)?;
+            // The tangential history carried over by the pairs' ids.
+            std::mem::swap(&mut pairs.history, &mut pairs.old_history);
+            pairs.history.resize(d, HISTORY * list.pair_count)?;
+            if list.old_pair_count == 0 {
+                pairs.old_history.resize(d, 0)?;
+            }
+            // SAFETY: the keys of both lists and both histories hold their pairs.
+            unsafe {
+                run(
+                    d,
+                    Kernel::CarryHistory,
+                    list.pair_count,
+                    &[
+                        Arg::U32(list.pair_count as u32),
+                        Arg::U32(HISTORY as u32),
+                        list.keys.arg(),
+                        Arg::U32(list.old_pair_count as u32),
+                        list.old_keys.arg(),
+                        pairs.old_history.arg(),
+                        pairs.history.arg(),
+                    ],
+                )?;
+            }
+            pairs.results.resize(d, RESULT * list.pair_count)?;
+            pairs.touching.resize(d, list.pair_count)?;
+        }
+        let count = list.pair_count;
+        pairs.counter.resize(d, 1)?;
+        // SAFETY: the parameters of sphere_contacts, gather_forces and
+        // count_touching (spheres.cu), every array sized for its pairs, particles or
+        // body types.
+        unsafe {
+            run(d, Kernel::ZeroWords, 1, &[Arg::U32(1), pairs.counter.arg()])?;
+            run(
+                d,
+                Kernel::SphereContacts,
+                count,
+                &[
+                    Arg::U32(count as u32),
+                    Arg::F64(dt),
+                    list.pairs.arg(),
+                    p.position.arg(),
+                    p.velocity.arg(),
+                    p.angular_momentum.arg(),
+                    p.body_type.arg(),
+                    p.frozen.arg(),
+                    t.radius.arg(),
+                    t.inverse_mass.arg(),
+                    t.inverse_inertia.arg(),
+                    t.material.arg(),
+                    Arg::U32(t.materials),
+                    t.material_pairs.arg(),
+                    pairs.history.arg(),
+                    pairs.results.arg(),
+                    pairs.touching.arg(),
+                ],
+            )?;
+            let g = self.gravity;
+            run(
+                d,
+                Kernel::GatherForces,
+                self.n,
+                &[
+                    Arg::U32(self.n as u32),
+                    Arg::F64(g.x),
+                    Arg::F64(g.y),
+                    Arg::F64(g.z),
+                    p.body_type.arg(),
+                    t.mass.arg(),
+                    p.frozen.arg(),
+                    list.incident_starts.arg(),
+                    list.incident.arg(),
+                    pairs.results.arg(),
+                    pairs.touching.arg(),
+                    p.force.arg(),
+                    p.torque.arg(),
+                    p.touching.arg(),
+                ],
+            )?;
+            run(
+                d,
+                Kernel::CountTouching,
+                count,
+                &[
+                    Arg::U32(count as u32),
+                    pairs.touching.arg(),
+                    pairs.counter.arg(),
+                ],
+            )?;
+        }
+        self.contacts = pairs.counter.get(d, 0)? as usize;
+        Ok(())
+    }
+
+    /// Copies the particles' state and forces, and the clock, into `world` (the
+    /// world the stepper was made from, or a copy of it).
+    pub fn download(&mut self, world: &mut World) -> Result<(), DeviceError> {
+        let (d, a) = (self.device.as_mut(), &self.particles);
+        let p = &mut world.particles;
+        let triples = |x: Vec<Real>| -> Vec<[Real; 3]> {
+            x.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect()
+        };
+        p.position = triples(a.position.read(d)?)
+            .into_iter()
+            .map(Point3::from)
+            .collect();
+        p.velocity = triples(a.velocity.read(d)?)
+            .into_iter()
+            .map(Vector3::from)
+            .collect();
+        p.angular_momentum = triples(a.angular_momentum.read(d)?)
+            .into_iter()
+            .map(Vector3::from)
+            .collect();
+        p.force = triples(a.force.read(d)?)
+            .into_iter()
+            .map(Vector3::from)
+            .collect();
+        p.torque = triples(a.torque.read(d)?)
+            .into_iter()
+            .map(Vector3::from)
+            .collect();
+        p.orientation = a
+            .orientation
+            .read(d)?
+            .chunks_exact(4)
+            .map(|q| UnitQuaternion::new_unchecked(Quaternion::new(q[3], q[0], q[1], q[2])))
+            .collect();
+        world.time = self.time;
+        Ok(())
+    }
+
+    /// Whether each particle touched another at the last force evaluation (frozen
+    /// ones count as touching).
+    pub fn touching(&mut self) -> Result<Vec<bool>, DeviceError> {
+        let flags = self.particles.touching.read(self.device.as_mut())?;
+        Ok(flags.into_iter().map(|t| t != 0).collect())
+    }
+
+    /// The pairs' tangential history, sorted by the particles' ids (pairs apart,
+    /// whose history is empty, left out): the CPU backend's
+    /// [`crate::engine::Backend::contact_history`].
+    pub fn contact_history(&mut self) -> Result<ContactHistory, DeviceError> {
+        let d = self.device.as_mut();
+        let keys = self.list.keys.read(d)?;
+        let history = self.pairs.history.read(d)?;
+        let pairs = keys
+            .chunks_exact(2)
+            .zip(history.chunks_exact(HISTORY))
+            .map(|(k, h)| {
+                let kept = TangentialHistory {
+                    spring: Vector3::new(h[0], h[1], h[2]),
+                    stiffness: h[3],
+                    ..Default::default()
+                };
+                ((k[0], k[1]), kept)
+            })
+            .filter(|(_, h)| !h.is_empty())
+            .collect();
+        Ok(ContactHistory {
+            pairs,
+            walls: Vec::new(),
+        })
+    }
+}
