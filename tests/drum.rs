@@ -12,7 +12,7 @@ mod common;
 use common::Picture;
 
 use talus::Real;
-use talus::analysis::Drum;
+use talus::analysis::{Drum, FlowSigns, Regime};
 use talus::scene::{Scene, Simulation};
 
 /// The drum scene: `fill` of the cross-section, the shell's motion as a TOML inline
@@ -376,6 +376,20 @@ fn a_run_writes_the_drum_files() {
         signs["surface_curvature"].as_f64().unwrap() > 0.0,
         "{signs}"
     );
+    // The regime named from them and the fraction in flight, as `Regime::of` names
+    // it.
+    let read = |k: &str| signs[k].as_f64();
+    let named = Regime::of(
+        &FlowSigns {
+            co_rotation: read("co_rotation"),
+            rim_coverage: coverage,
+            at_rest: read("at_rest").unwrap(),
+            surface_curvature: read("surface_curvature"),
+        },
+        json["airborne_fraction"].as_f64(),
+    )
+    .unwrap();
+    assert_eq!(json["regime"].as_str(), Some(named.name()), "{json}");
     let summary: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
     assert_eq!(summary["drum"]["samples"], json["samples"]);

@@ -17,7 +17,7 @@ use nalgebra::{Point3, Vector3};
 use serde::{Deserialize, Serialize};
 
 use super::field::VelocityField;
-use super::regime::{FlowSignSums, FlowSigns};
+use super::regime::{FlowSignSums, FlowSigns, Regime};
 use super::surface::{SurfaceFit, fit_surface};
 use crate::Real;
 use crate::world::{MassMoments, World};
@@ -243,6 +243,8 @@ pub struct DrumSummary {
     pub airborne_fraction: Option<Real>,
     /// The signs of the flow regime the samples show (see [`super::regime`]).
     pub flow_signs: Option<FlowSigns>,
+    /// The regime named from them.
+    pub regime: Option<Regime>,
     /// Flowing-layer thickness at the middle of the surface, m.
     pub flowing_layer: Option<Real>,
     /// Particle volume over the drum's volume.
@@ -471,6 +473,7 @@ impl DrumMonitor {
             .sum();
         let drum_volume = std::f64::consts::PI * self.drum.radius.powi(2) * self.drum.length;
         let airborne = (self.airborne.1 > 0).then(|| self.airborne.0 / self.airborne.1 as Real);
+        let signs = self.regime.signs();
         DrumSummary {
             average_from: self.window_start,
             averaged_over: span,
@@ -500,7 +503,8 @@ impl DrumMonitor {
             angle_of_repose: angle,
             angle_of_repose_std: std,
             airborne_fraction: airborne,
-            flow_signs: self.regime.signs(),
+            flow_signs: signs,
+            regime: signs.and_then(|s| Regime::of(&s, airborne)),
             flowing_layer: self
                 .mean_surface()
                 .and_then(|s| self.field.flowing_layer(&s)),

@@ -14,5 +14,5 @@ pub mod surface;
 
 pub use drum::{Drum, DrumMonitor, DrumRow, DrumSummary, Revolution};
 pub use field::VelocityField;
-pub use regime::FlowSigns;
+pub use regime::{FlowSigns, Regime};
 pub use surface::{SurfaceFit, fit_surface};

@@ -20,9 +20,13 @@
 //!   the straight surface of a rolling one.
 //!
 //! Over the analysis window these are averaged ([`FlowSigns`]); with the fraction
-//! in flight ([`super::DrumSummary::airborne_fraction`]) they are what a regime is
-//! named from. The names themselves (thresholds on these signs) wait for the sweep
-//! over Froude numbers that sets them against Mellmann's map.
+//! in flight ([`super::DrumSummary::airborne_fraction`]) they name the regime
+//! ([`Regime::of`]): a ring on the shell centrifuges; a rim layer that moves at
+//! less than half the shell's speed slips; a tenth of the slice in flight
+//! cataracts; a bed at rest in the drum in three samples of ten slumps; a curved
+//! surface cascades; a straight one rolls. The thresholds were set against the
+//! quasi-2D example's sweep over Froude numbers 1e-3 … 1.5 and Mellmann's (2001)
+//! bands (`examples/drum/README.md`).
 
 use serde::{Deserialize, Serialize};
 
@@ -36,6 +40,73 @@ const RIM_LAYER: Real = 1.5;
 /// A sample is at rest in the drum when its activity is below this share of the
 /// window's mean activity.
 pub const AT_REST: Real = 0.1;
+
+/// Rim coverage of a centrifuging bed: a ring around the shell.
+pub const RING: Real = 0.9;
+/// Co-rotation below which the bed slips: its rim layer moves at less than half
+/// the shell's speed.
+pub const SLIPPING: Real = 0.5;
+/// Fraction of the slice in flight (more than two diameters above the fitted
+/// surface) of a cataracting bed.
+pub const THROWN: Real = 0.1;
+/// Share of samples at rest in the drum of a slumping bed.
+pub const SLUMPING: Real = 0.3;
+/// Surface curvature of a cascading bed (an S or kidney-shaped surface); a
+/// straight, rolling surface stays below (the synthetic beds of the tests: 0.016 for
+/// a straight surface of packed spheres, 0.060 for an S of two diameters' bulge).
+pub const CURVED: Real = 0.04;
+
+/// The forms of transverse motion in a rotating drum, after Mellmann (2001), in
+/// the order of growing Froude number (slipping aside: it needs a smooth shell).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Regime {
+    /// The bed slides on the shell instead of turning with it.
+    Slipping,
+    /// The bed turns with the drum and avalanches from time to time.
+    Slumping,
+    /// A continuous flowing layer under a straight surface.
+    Rolling,
+    /// A continuous flowing layer under a curved (S-shaped) surface.
+    Cascading,
+    /// Particles thrown from the rising bed into free flight.
+    Cataracting,
+    /// A ring on the shell.
+    Centrifuging,
+}
+
+impl Regime {
+    /// The regime the signs of a window show, with `airborne` the fraction of the
+    /// slice in flight; `None` with the drum at rest (no co-rotation to measure).
+    pub fn of(signs: &FlowSigns, airborne: Option<Real>) -> Option<Regime> {
+        let co_rotation = signs.co_rotation?;
+        Some(if signs.rim_coverage >= RING {
+            Regime::Centrifuging
+        } else if co_rotation < SLIPPING {
+            Regime::Slipping
+        } else if airborne.unwrap_or(0.0) >= THROWN {
+            Regime::Cataracting
+        } else if signs.at_rest >= SLUMPING {
+            Regime::Slumping
+        } else if signs.surface_curvature.unwrap_or(0.0) >= CURVED {
+            Regime::Cascading
+        } else {
+            Regime::Rolling
+        })
+    }
+
+    /// Its name, as `drum.json` writes it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Regime::Slipping => "slipping",
+            Regime::Slumping => "slumping",
+            Regime::Rolling => "rolling",
+            Regime::Cascading => "cascading",
+            Regime::Cataracting => "cataracting",
+            Regime::Centrifuging => "centrifuging",
+        }
+    }
+}
 
 /// The signs of a window's flow regime (see the module).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -247,5 +318,39 @@ mod tests {
         signs.add(&ring, omega, R, D, None);
         let s = signs.signs().unwrap();
         assert_eq!((s.rim_coverage, s.co_rotation), (1.0, Some(1.0)));
+    }
+
+    /// The synthetic beds are named for what they are built to be.
+    #[test]
+    fn the_synthetic_beds_are_named_for_what_they_are() {
+        let name = |s: &FlowSigns, airborne| Regime::of(s, Some(airborne));
+        let rolling = signs_of(&[bed(35.0, 0.0, 2.0, 0.3)], 2.0);
+        let cascading = signs_of(&[bed(40.0, 2.0 * D, 3.0, 0.5)], 3.0);
+        assert_eq!(name(&rolling, 0.0), Some(Regime::Rolling));
+        assert_eq!(name(&cascading, 0.0), Some(Regime::Cascading));
+        // The same beds with an eighth of the slice in flight.
+        assert_eq!(name(&rolling, 0.125), Some(Regime::Cataracting));
+        let mut slumping = vec![bed(30.0, 0.0, 0.5, 0.0); 8];
+        slumping.extend([bed(30.0, 0.0, 0.5, 0.4), bed(30.0, 0.0, 0.5, 0.4)]);
+        assert_eq!(name(&signs_of(&slumping, 0.5), 0.0), Some(Regime::Slumping));
+        let still = signs_of(&[bed(20.0, 0.0, 0.0, 0.0)], 2.0);
+        assert_eq!(name(&still, 0.0), Some(Regime::Slipping));
+        let ring = FlowSigns {
+            co_rotation: Some(1.0),
+            rim_coverage: 1.0,
+            at_rest: 0.0,
+            surface_curvature: None,
+        };
+        assert_eq!(name(&ring, 0.0), Some(Regime::Centrifuging));
+        let resting = FlowSigns {
+            co_rotation: None,
+            ..ring
+        };
+        assert_eq!(Regime::of(&resting, None), None);
+        assert_eq!(
+            serde_json::to_string(&Regime::Cataracting).unwrap(),
+            "\"cataracting\""
+        );
+        assert_eq!(Regime::Cataracting.name(), "cataracting");
     }
 }
