@@ -73,7 +73,7 @@ fn scan(
     n: usize,
     chunks: &mut Array<u32>,
 ) -> Result<usize, DeviceError> {
-    let count = U32(n);
+    let n_arg = count(n);
     chunks.resize(device, scan_chunks(n))?;
     // SAFETY: `values` holds n + 1 entries, `chunks` one per chunk (scan.cu).
     unsafe {
@@ -81,30 +81,29 @@ fn scan(
             device,
             Kernel::ScanChunkTotals,
             scan_chunks(n),
-            &[count, values.arg(), chunks.arg()],
+            &[n_arg, values.arg(), chunks.arg()],
         )?;
-        run(device, Kernel::ScanChunkOffsets, 1, &[count, chunks.arg()])?;
+        run(device, Kernel::ScanChunkOffsets, 1, &[n_arg, chunks.arg()])?;
         run(
             device,
             Kernel::ScanApply,
             scan_chunks(n),
-            &[count, values.arg(), chunks.arg()],
+            &[n_arg, values.arg(), chunks.arg()],
         )?;
     }
     Ok(values.get(device, n)? as usize)
 }
 
-/// `n` as a kernel's `unsigned` argument (the launch fails on more than 2³² − 1
-/// threads first).
-#[allow(non_snake_case)]
-fn U32(n: usize) -> Arg {
+/// The count `n` as a kernel's `unsigned` argument (a launch of more than 2³² − 1
+/// threads fails before its arguments are read).
+fn count(n: usize) -> Arg {
     Arg::U32(n as u32)
 }
 
 /// Sets `values[..n]` to zero.
 fn zero(device: &mut dyn Device, values: &Array<u32>, n: usize) -> Result<(), DeviceError> {
     // SAFETY: `values` holds at least n entries.
-    unsafe { run(device, Kernel::ZeroWords, n, &[U32(n), values.arg()]) }
+    unsafe { run(device, Kernel::ZeroWords, n, &[count(n), values.arg()]) }
 }
 
 /// What the list is built from: the particles' positions, body types and ids, and
@@ -153,7 +152,7 @@ impl DeviceList {
                 Kernel::MovedTooFar,
                 n,
                 &[
-                    U32(n),
+                    count(n),
                     position.arg(),
                     self.anchors.arg(),
                     Arg::F64(limit),
@@ -184,7 +183,7 @@ impl DeviceList {
                 Kernel::BinParticles,
                 n,
                 &[
-                    U32(n),
+                    count(n),
                     at.position.arg(),
                     cell,
                     mask,
@@ -209,20 +208,24 @@ impl DeviceList {
                 device,
                 Kernel::CopyWords,
                 buckets + 1,
-                &[U32(buckets + 1), self.bucket_starts.arg(), self.fill.arg()],
+                &[
+                    count(buckets + 1),
+                    self.bucket_starts.arg(),
+                    self.fill.arg(),
+                ],
             )?;
             run(
                 device,
                 Kernel::ScatterParticles,
                 n,
                 &[
-                    U32(n),
+                    count(n),
                     self.bucket.arg(),
                     self.fill.arg(),
                     self.sorted.arg(),
                 ],
             )?;
-            let args: Vec<Arg> = [U32(n)]
+            let args: Vec<Arg> = [count(n)]
                 .into_iter()
                 .chain(reach)
                 .chain(grid)
@@ -241,10 +244,10 @@ impl DeviceList {
         self.keys.resize(device, 2 * pairs)?;
         self.anchors.resize(device, 3 * n)?;
         zero(device, &self.incident_starts, n + 1)?;
-        let count = U32(pairs);
+        let pair_arg = count(pairs);
         // SAFETY: as above; the pair arrays hold `pairs` pairs.
         unsafe {
-            let args: Vec<Arg> = [U32(n)]
+            let args: Vec<Arg> = [count(n)]
                 .into_iter()
                 .chain(reach)
                 .chain(grid)
@@ -255,7 +258,7 @@ impl DeviceList {
                 device,
                 Kernel::CountIncident,
                 pairs,
-                &[count, self.pairs.arg(), self.incident_starts.arg()],
+                &[pair_arg, self.pairs.arg(), self.incident_starts.arg()],
             )?;
         }
         scan(device, &self.incident_starts, n, &mut self.chunks)?;
@@ -265,14 +268,14 @@ impl DeviceList {
                 device,
                 Kernel::CopyWords,
                 n + 1,
-                &[U32(n + 1), self.incident_starts.arg(), self.fill.arg()],
+                &[count(n + 1), self.incident_starts.arg(), self.fill.arg()],
             )?;
             run(
                 device,
                 Kernel::FillIncident,
                 pairs,
                 &[
-                    count,
+                    pair_arg,
                     self.pairs.arg(),
                     self.fill.arg(),
                     self.incident.arg(),
@@ -282,19 +285,19 @@ impl DeviceList {
                 device,
                 Kernel::SortIncident,
                 n,
-                &[U32(n), self.incident_starts.arg(), self.incident.arg()],
+                &[count(n), self.incident_starts.arg(), self.incident.arg()],
             )?;
             run(
                 device,
                 Kernel::PairKeys,
                 pairs,
-                &[count, self.pairs.arg(), at.id.arg(), self.keys.arg()],
+                &[pair_arg, self.pairs.arg(), at.id.arg(), self.keys.arg()],
             )?;
             run(
                 device,
                 Kernel::CopyDoubles,
                 3 * n,
-                &[U32(3 * n), at.position.arg(), self.anchors.arg()],
+                &[count(3 * n), at.position.arg(), self.anchors.arg()],
             )?;
         }
         self.valid = true;
