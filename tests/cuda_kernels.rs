@@ -22,6 +22,11 @@ fn every_kernel_compiles_with_nvrtc_for_every_architecture() {
     for file in &FILES {
         for arch in ARCHITECTURES {
             let ptx = compile(file, arch).unwrap_or_else(|e| panic!("{e}"));
+            // scripts/ptxas-report.sh reads the PTX from here.
+            if let Some(dir) = std::env::var_os("TALUS_PTX_DIR") {
+                let name = format!("{}.{arch}.ptx", file.name.trim_end_matches(".cu"));
+                std::fs::write(std::path::Path::new(&dir).join(name), &ptx).unwrap();
+            }
             assert!(ptx.contains(&format!(".target {arch}")), "{arch}");
             let kernels = Kernel::ALL
                 .into_iter()

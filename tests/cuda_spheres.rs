@@ -110,12 +110,13 @@ fn steps_as_the_cpu_backend(device: Box<dyn Device>) {
     let mut spheres = DeviceSpheres::new(device, &start, &params).unwrap();
     spheres.initialise(dt).unwrap();
     let mut device_world = start.clone();
-    let (mut most_contacts, mut most_springs) = (0, 0);
+    let (mut most_contacts, mut most_springs, mut most_pairs) = (0, 0, 0);
     for step in 1..=1000 {
         cpu.step(&mut cpu_world, dt);
         spheres.step(dt).unwrap();
         assert_eq!(spheres.contacts(), cpu.stats().pair_contacts, "step {step}");
         most_contacts = most_contacts.max(spheres.contacts());
+        most_pairs = most_pairs.max(spheres.candidate_pairs());
         if step % 100 != 0 {
             continue;
         }
@@ -147,6 +148,22 @@ fn steps_as_the_cpu_backend(device: Box<dyn Device>) {
         spheres.list_builds()
     );
     assert_eq!(spheres.list_builds(), cpu.stats().list_builds);
+    // Device memory: 230 bytes a particle (its state 166, the list's 64 with a grid
+    // of at least 2n buckets) and 201 a candidate pair (the pair 8, its incidences
+    // 8, ids 16, history 32, result 88, touching 1, and the previous build's ids
+    // and history, 48), buffers sized for the most pairs so far with room to grow
+    // by half.
+    let (n, pairs) = (1000.0, most_pairs as f64);
+    let bytes = spheres.device_bytes() as f64;
+    eprintln!("{bytes} bytes for {n} spheres and at most {pairs} candidate pairs");
+    assert!(
+        bytes <= 1.5 * (230.0 * n + 201.0 * pairs) + 8192.0,
+        "{bytes} bytes"
+    );
+    assert!(
+        bytes >= 166.0 * n + 201.0 * spheres.candidate_pairs() as f64,
+        "{bytes} bytes"
+    );
 }
 
 #[test]

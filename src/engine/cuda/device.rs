@@ -238,6 +238,11 @@ impl<T: Pod> Array<T> {
         self.len == 0
     }
 
+    /// Bytes of device memory it holds (its buffer's size, room to grow included).
+    pub fn bytes(&self, device: &dyn Device) -> usize {
+        self.buffer.map_or(0, |b| device.size(b))
+    }
+
     /// The array as a launch argument (it must have been sized).
     pub fn arg(&self) -> Arg {
         Arg::Buffer(self.buffer.expect("a sized device array"))

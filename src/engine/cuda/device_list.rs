@@ -126,6 +126,26 @@ impl DeviceList {
         }
     }
 
+    /// Bytes of device memory the list holds.
+    pub fn bytes(&self, device: &dyn Device) -> usize {
+        let words = [
+            &self.bucket,
+            &self.bucket_starts,
+            &self.sorted,
+            &self.fill,
+            &self.offsets,
+            &self.pairs,
+            &self.incident_starts,
+            &self.incident,
+            &self.moved,
+            &self.chunks,
+        ];
+        words.iter().map(|a| a.bytes(device)).sum::<usize>()
+            + self.keys.bytes(device)
+            + self.old_keys.bytes(device)
+            + self.anchors.bytes(device)
+    }
+
     /// Makes the list stale until the next build.
     pub fn invalidate(&mut self) {
         self.valid = false;

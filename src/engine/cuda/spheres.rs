@@ -228,6 +228,39 @@ impl DeviceSpheres {
         self.device.description()
     }
 
+    /// Bytes of device memory the stepper holds: particles, body types, the list
+    /// and the pairs' history and results (buffers have room to grow by half).
+    pub fn device_bytes(&self) -> usize {
+        let d = self.device.as_ref();
+        let (p, t, q) = (&self.particles, &self.types, &self.pairs);
+        let doubles = [
+            &p.position,
+            &p.velocity,
+            &p.orientation,
+            &p.angular_momentum,
+            &p.force,
+            &p.torque,
+            &t.mass,
+            &t.inertia,
+            &t.radius,
+            &t.inverse_mass,
+            &t.inverse_inertia,
+            &t.material_pairs,
+            &q.history,
+            &q.old_history,
+            &q.results,
+        ];
+        let bytes = [&p.frozen, &p.touching, &q.touching];
+        doubles.iter().map(|a| a.bytes(d)).sum::<usize>()
+            + bytes.iter().map(|a| a.bytes(d)).sum::<usize>()
+            + [&p.body_type, &t.material, &q.counter]
+                .iter()
+                .map(|a| a.bytes(d))
+                .sum::<usize>()
+            + p.id.bytes(d)
+            + self.list.bytes(d)
+    }
+
     /// Pairs that touched at the last force evaluation.
     pub fn contacts(&self) -> usize {
         self.contacts
