@@ -11,11 +11,13 @@
 thread_local dim3 threadIdx, blockIdx, blockDim, gridDim;
 
 #include "vec.cuh"
+#include "contact.cuh"
 
 #include "integrate.cu"
 #include "list.cu"
 #include "scan.cu"
 #include "spheres.cu"
+#include "walls.cu"
 
 // Sets the built-ins of the calling thread before it runs one kernel thread.
 extern "C" void talus_host_at(unsigned block, unsigned thread, unsigned block_dim,
@@ -57,6 +59,7 @@ static const Entry kernels[] = {
     KERNEL(copy_doubles),      KERNEL(scan_chunk_totals), KERNEL(scan_chunk_offsets),
     KERNEL(scan_apply),        KERNEL(zero_words),       KERNEL(copy_words),
     KERNEL(sphere_contacts),   KERNEL(gather_forces),    KERNEL(count_touching),
+    KERNEL(sphere_walls),      KERNEL(sum_walls),
 };
 
 // The trampoline of the kernel named `name`, or null.

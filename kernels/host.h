@@ -19,6 +19,8 @@ extern thread_local dim3 threadIdx, blockIdx, blockDim, gridDim;
 #define __forceinline__ inline
 
 using std::floor;
+using std::isfinite;
+using std::round;
 using std::fmax;
 using std::fmin;
 using std::sqrt;

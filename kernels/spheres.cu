@@ -3,60 +3,11 @@
 // gather of every particle's forces (engine/cpu/pairs.rs): the CPU backend's
 // operations in its order, so the same bits.
 //
-// Layouts: per body type its radius, 1/m, 1/I, m and material; per pair of
-// materials (row-major) E*, G*, β, √(4G*/E*) and the friction coefficient; per pair
-// its tangential history (spring, 3 doubles, and the stiffness it was stretched at)
+// The law is contact.cuh's. Layouts: per body type its radius, 1/m, 1/I, m and
+// material; per pair of materials (row-major) E*, G*, β, √(4G*/E*) and the friction
+// coefficient; per pair its tangential history (spring, 3 doubles, and the stiffness it was stretched at)
 // and its result (force on the second particle, torque on the first and on the
 // second, elastic energy, energy dissipated: 11 doubles) and whether it touches.
-
-#define HISTORY_DOUBLES 4u
-#define RESULT_DOUBLES 11u
-#define MATERIAL_DOUBLES 5u
-
-// 2 √(5/6), the factor of the damping coefficients.
-#define DAMPING_FACTOR 1.8257418583505537
-
-struct Spring {
-    Vec3 spring;
-    double stiffness;
-};
-
-static __device__ __forceinline__ double spring_energy(Spring s) {
-    return 0.5 * s.stiffness * norm_squared(s.spring);
-}
-
-// Cundall–Strack friction (contact/tangential.rs): the force on body 2, the spring
-// kept in *kept.
-static __device__ __forceinline__ Vec3 tangential_force(Spring history, Vec3 normal,
-                                                        Vec3 relative_velocity, double dt,
-                                                        double stiffness, double damping,
-                                                        double limit, Spring* kept) {
-    Vec3 previous = history.spring;
-    Vec3 spring = sub(previous, scale(normal, dot(normal, previous)));
-    double projected = norm_squared(spring);
-    if (projected > 0.0) {
-        double keep = history.stiffness > 0.0 && stiffness > history.stiffness
-                          ? history.stiffness / stiffness
-                          : 1.0;
-        spring = scale(spring, keep * sqrt(norm_squared(previous) / projected));
-    }
-    Vec3 vt = sub(relative_velocity, scale(normal, dot(normal, relative_velocity)));
-    spring = add(spring, scale(vt, dt));
-    Vec3 trial = sub(scale(spring, -stiffness), scale(vt, damping));
-    double squared = norm_squared(trial);
-    if (squared <= limit * limit || squared == 0.0) {
-        *kept = Spring{spring, stiffness};
-        return trial;
-    }
-    double magnitude = sqrt(squared);
-    Vec3 force = scale(trial, limit / magnitude);
-    double length = norm(spring);
-    if (stiffness > 0.0 && stiffness * length > limit) {
-        spring = scale(spring, limit / (stiffness * length));
-    }
-    *kept = Spring{spring, stiffness};
-    return force;
-}
 
 // One thread per candidate pair: its contact, if the spheres overlap and one of
 // them moves, into its result; its history replaced by what the contact leaves
@@ -111,40 +62,16 @@ extern "C" __global__ void sphere_contacts(
     double inverse_mass = type_inverse_mass[ti] + type_inverse_mass[tj];
     const double* m =
         material_pairs + MATERIAL_DOUBLES * (type_material[ti] * materials + type_material[tj]);
-    double young = m[0], shear = m[1], beta = m[2], damping_ratio = m[3], friction = m[4];
-
-    // Hertz–Mindlin (contact/hertz_mindlin.rs).
-    double radius = ra * rb / (ra + rb);
-    double mass = 1.0 / inverse_mass;
-    double a = sqrt(radius * depth);
-    double tangent = 2.0 * young * a;
-    double stiffness = (2.0 / 3.0) * tangent;
-    double elastic = stiffness * depth;
-    double damping_n = -DAMPING_FACTOR * beta * sqrt(tangent * mass);
-    double vn = dot(relative, normal);
-    double normal_force = fmax(elastic - damping_n * vn, 0.0);
-    double kt = 8.0 * shear * a;
-    double damping_t = damping_n * damping_ratio;
-    Spring kept;
-    Vec3 t = tangential_force(before, normal, relative, dt, kt, damping_t, friction * normal_force,
-                              &kept);
-    Vec3 force = add(scale(normal, normal_force), t);
-    Vec3 torque = cross(lever_j, force);
-    double energy = 0.4 * elastic * depth + spring_energy(kept);
-
-    // Energy dissipated over the step (engine/cpu/forces.rs `dissipated`): the work
-    // of the force less its elastic normal part at the step's end velocity.
-    Vec3 damping = sub(force, scale(normal, elastic));
-    Vec3 moved = add(relative, scale(force, 0.5 * dt * inverse_mass));
-    double dissipated = -dt * (dot(damping, moved) + dot(Vec3{0.0, 0.0, 0.0}, spin)) -
-                        (spring_energy(kept) - spring_energy(before));
-
+    RoundContact c = round_contact(depth, normal, lever_j, relative, spin, inverse_mass,
+                                   ra * rb / (ra + rb), m, before, dt);
+    Vec3 force = c.force, torque = c.torque;
+    Spring kept = c.kept;
     Vec3 reaction = scale(add(torque, cross(sub(xj, xi), force)), -1.0);
     store3(result, 0, force);
     store3(result, 1, reaction);
     store3(result, 2, torque);
-    result[9] = energy;
-    result[10] = dissipated;
+    result[9] = c.energy;
+    result[10] = c.dissipated;
     touching[e] = 1;
     history[HISTORY_DOUBLES * e] = kept.spring.x;
     history[HISTORY_DOUBLES * e + 1] = kept.spring.y;

@@ -13,7 +13,7 @@ use rand_pcg::Pcg64;
 use talus::engine::cuda::device::{Device, HostDevice};
 use talus::engine::cuda::driver::CudaDevice;
 use talus::engine::cuda::spheres::{DeviceSpheres, SpheresError};
-use talus::engine::{Backend, CpuBackend};
+use talus::engine::{Backend, CpuBackend, StepParams};
 use talus::scene::Scene;
 use talus::world::World;
 
@@ -60,8 +60,14 @@ max = [0.11, 0.01, 0.01]
 /// 12 mm, converging on its centre at up to 2 m/s with random spins (every
 /// thirteenth frozen): within a few hundred steps most spheres are in contact,
 /// sliding and sticking, and the list is rebuilt many times.
-fn cloud() -> (World, talus::engine::StepParams) {
-    let scene = Scene::parse(SCENE, Path::new("cloud.toml")).unwrap();
+fn cloud() -> (World, StepParams) {
+    cloud_in("", -35.0)
+}
+
+/// The cloud with `walls` (scene text) added, its spheres moving at `spread` times
+/// their position (negative: converging) plus a random velocity.
+fn cloud_in(walls: &str, spread: f64) -> (World, StepParams) {
+    let scene = Scene::parse(&format!("{SCENE}{walls}"), Path::new("cloud.toml")).unwrap();
     let params = scene.step_params();
     let mut world = scene.world;
     assert_eq!(world.body_types.len(), 2);
@@ -86,7 +92,7 @@ fn cloud() -> (World, talus::engine::StepParams) {
             UnitQuaternion::from_scaled_axis(axis),
             k as u64,
         );
-        p.velocity[k] = u - x * 35.0;
+        p.velocity[k] = u + x * spread;
         p.angular_momentum[k] = l;
         p.frozen[k] = k % 13 == 5;
     }
@@ -103,15 +109,75 @@ fn host(block: u32) -> Box<HostDevice> {
 /// count and the candidate pairs.
 fn steps_as_the_cpu_backend(device: Box<dyn Device>) {
     let (start, params) = cloud();
+    let run = parity(device, &start, &params, 1000, false);
+    // A test of contacts, friction and list builds, not of free flight: the cloud
+    // collapses (about 1500 contacts at once) and bounces apart.
+    assert!(
+        run.most_contacts > 1200,
+        "{} contacts at most",
+        run.most_contacts
+    );
+    assert!(
+        run.most_springs > 1000,
+        "{} springs at most",
+        run.most_springs
+    );
+    assert!(run.builds > 10, "{} builds", run.builds);
+    // Device memory: 230 bytes a particle (its state 166, the list's 64 with a grid
+    // of at least 2n buckets) and 201 a candidate pair (the pair 8, its incidences
+    // 8, ids 16, history 32, result 88, touching 1, and the previous build's ids
+    // and history, 48), buffers sized for the most pairs so far with room to grow
+    // by half.
+    let (n, pairs) = (1000.0, run.most_pairs as f64);
+    let bytes = run.bytes as f64;
+    eprintln!("{bytes} bytes for {n} spheres and at most {pairs} candidate pairs");
+    assert!(
+        bytes <= 1.5 * (230.0 * n + 201.0 * pairs) + 8192.0,
+        "{bytes} bytes"
+    );
+    assert!(
+        bytes >= 166.0 * n + 201.0 * run.last_pairs as f64,
+        "{bytes} bytes"
+    );
+}
+
+/// What a parity run saw.
+struct Parity {
+    most_contacts: usize,
+    most_wall_contacts: usize,
+    most_springs: usize,
+    most_pairs: usize,
+    last_pairs: usize,
+    builds: u64,
+    bytes: usize,
+}
+
+/// `steps` steps of `start` on `device` and in the CPU backend: positions,
+/// velocities, orientations, angular momenta, forces and torques, the walls'
+/// poses, forces, torques and facet forces are the CPU backend's bits at every
+/// hundredth step, and so are the tangential history of every pair and wall patch,
+/// the contact counts and the touching flags. The CPU backend also rebuilds its
+/// list when a particle has moved a skin in a moving wall's frame (its wall facet
+/// lists), the device's only when one moved half a skin: where walls move
+/// (`moving_walls`), the lists' builds and candidate counts differ, never the
+/// contacts.
+fn parity(
+    device: Box<dyn Device>,
+    start: &World,
+    params: &StepParams,
+    steps: usize,
+    moving_walls: bool,
+) -> Parity {
     let dt = 2e-5;
     let mut cpu_world = start.clone();
-    let mut cpu = CpuBackend::new(params);
+    let mut cpu = CpuBackend::new(*params);
     cpu.initialise(&mut cpu_world, dt);
-    let mut spheres = DeviceSpheres::new(device, &start, &params).unwrap();
+    let mut spheres = DeviceSpheres::new(device, start, params).unwrap();
     spheres.initialise(dt).unwrap();
     let mut device_world = start.clone();
     let (mut most_contacts, mut most_springs, mut most_pairs) = (0, 0, 0);
-    for step in 1..=1000 {
+    let mut most_wall_contacts = 0;
+    for step in 1..=steps {
         cpu.step(&mut cpu_world, dt);
         spheres.step(dt).unwrap();
         assert_eq!(spheres.contacts(), cpu.stats().pair_contacts, "step {step}");
@@ -132,38 +198,39 @@ fn steps_as_the_cpu_backend(device: Box<dyn Device>) {
         assert_eq!(a.force, b.force, "forces at step {step}");
         assert_eq!(a.torque, b.torque, "torques at step {step}");
         assert_eq!(cpu_world.time, device_world.time);
-        assert_eq!(spheres.candidate_pairs(), cpu.stats().candidate_pairs);
+        if !moving_walls {
+            assert_eq!(spheres.candidate_pairs(), cpu.stats().candidate_pairs);
+        }
         let history = cpu.contact_history();
         assert_eq!(spheres.contact_history().unwrap(), history, "step {step}");
-        most_springs = most_springs.max(history.pairs.len());
+        most_springs = most_springs.max(history.pairs.len() + history.walls.len());
+        let wall_contacts = cpu.stats().contacts - cpu.stats().pair_contacts;
+        assert_eq!(
+            spheres.wall_contacts().unwrap(),
+            wall_contacts,
+            "step {step}"
+        );
+        most_wall_contacts = most_wall_contacts.max(wall_contacts);
+        for (a, b) in cpu_world.walls.iter().zip(&device_world.walls) {
+            assert_eq!(a.pose, b.pose, "{} at step {step}", a.name);
+            assert_eq!(a.force, b.force, "{} at step {step}", a.name);
+            assert_eq!(a.torque, b.torque, "{} at step {step}", a.name);
+            assert_eq!(a.facet_force, b.facet_force, "{} at step {step}", a.name);
+        }
         assert_eq!(spheres.touching().unwrap(), cpu.touching(), "step {step}");
     }
-    // A test of contacts, friction and list builds, not of free flight: the cloud
-    // collapses (about 1500 contacts at once) and bounces apart.
-    assert!(most_contacts > 1200, "{most_contacts} contacts at most");
-    assert!(most_springs > 1000, "{most_springs} springs at most");
-    assert!(
-        spheres.list_builds() > 10,
-        "{} builds",
-        spheres.list_builds()
-    );
-    assert_eq!(spheres.list_builds(), cpu.stats().list_builds);
-    // Device memory: 230 bytes a particle (its state 166, the list's 64 with a grid
-    // of at least 2n buckets) and 201 a candidate pair (the pair 8, its incidences
-    // 8, ids 16, history 32, result 88, touching 1, and the previous build's ids
-    // and history, 48), buffers sized for the most pairs so far with room to grow
-    // by half.
-    let (n, pairs) = (1000.0, most_pairs as f64);
-    let bytes = spheres.device_bytes() as f64;
-    eprintln!("{bytes} bytes for {n} spheres and at most {pairs} candidate pairs");
-    assert!(
-        bytes <= 1.5 * (230.0 * n + 201.0 * pairs) + 8192.0,
-        "{bytes} bytes"
-    );
-    assert!(
-        bytes >= 166.0 * n + 201.0 * spheres.candidate_pairs() as f64,
-        "{bytes} bytes"
-    );
+    if !moving_walls {
+        assert_eq!(spheres.list_builds(), cpu.stats().list_builds);
+    }
+    Parity {
+        most_contacts,
+        most_wall_contacts,
+        most_springs,
+        most_pairs,
+        last_pairs: spheres.candidate_pairs(),
+        builds: spheres.list_builds(),
+        bytes: spheres.device_bytes(),
+    }
 }
 
 #[test]
@@ -190,6 +257,98 @@ fn on_a_gpu_the_cloud_steps_as_the_cpu_backend_to_the_bit() {
             eprintln!("skipped: {e}");
         }
     }
+}
+
+/// An open box of STL-like facets (floor and four sides, two triangles each) around
+/// the cloud, which expands into it under gravity: every sphere of the outer layer
+/// meets a wall, a face, an edge or a corner (two or three patches at once), and
+/// slides on it.
+#[test]
+fn a_cloud_thrown_into_a_box_steps_as_the_cpu_backend_to_the_bit() {
+    let walls = r#"
+[[wall]]
+name = "box"
+material = "steel"
+geometry = { kind = "box", min = [-0.07, -0.07, -0.07], max = [0.07, 0.07, 0.3], open_top = true }
+"#;
+    let (start, params) = cloud_in(walls, 30.0);
+    let run = parity(host(64), &start, &params, 1000, false);
+    assert!(
+        run.most_wall_contacts > 100,
+        "{} wall contacts at most",
+        run.most_wall_contacts
+    );
+    assert!(
+        run.most_contacts > 100,
+        "{} contacts at most",
+        run.most_contacts
+    );
+}
+
+/// A drum turning at 3 rad/s about a horizontal axis, its end plates attached to
+/// the shell (walls that move, their facets placed anew every step), with 53 beads
+/// falling onto the shell and carried up: 5000 steps.
+#[test]
+fn beads_in_a_turning_drum_step_as_the_cpu_backend_to_the_bit() {
+    let text = r#"
+[simulation]
+dt = 2e-5
+end_time = 1.0
+gravity = [0.0, 0.0, -9.81]
+[contact]
+law = "hertz_mindlin"
+[materials.bead]
+density = 2500.0
+young = 3e5
+poisson = 0.25
+restitution = 0.5
+friction = 0.5
+[materials.shell]
+density = 2500.0
+young = 1e6
+poisson = 0.3
+restitution = 0.6
+friction = 0.7
+[shapes.bead]
+kind = "sphere"
+radius = 0.004
+[[wall]]
+name = "shell"
+material = "shell"
+geometry = { kind = "cylinder", base = [0.0, 0.0, 0.0], axis = [0.0, 1.0, 0.0], length = 0.009, radius = 0.06, sides = 72 }
+motion = { kind = "rotation", axis = [0.0, 1.0, 0.0], point = [0.0, 0.0045, 0.0], rate = 3.0 }
+[[wall]]
+name = "front"
+material = "bead"
+geometry = { kind = "disc", centre = [0.0, 0.0, 0.0], normal = [0.0, 1.0, 0.0], radius = 0.06, sides = 72 }
+motion = { kind = "attached", to = "shell" }
+[[wall]]
+name = "back"
+material = "bead"
+geometry = { kind = "disc", centre = [0.0, 0.009, 0.0], normal = [0.0, -1.0, 0.0], radius = 0.06, sides = 72 }
+motion = { kind = "attached", to = "shell" }
+[[particles]]
+kind = "lattice"
+shape = "bead"
+material = "bead"
+min = [-0.06, 0.0, -0.06]
+max = [0.06, 0.009, 0.06]
+inside = { centre = [0.0, 0.0045, 0.0], axis = [0.0, 1.0, 0.0], radius = 0.06, fill = 0.4 }
+"#;
+    let scene = Scene::parse(text, Path::new("drum.toml")).unwrap();
+    let run = parity(host(32), &scene.world, &scene.step_params(), 5000, true);
+    // The bed rests on the shell and rubs on the plates (21 wall contacts, 73 in
+    // all, at the most of the hundredth steps).
+    assert!(
+        run.most_wall_contacts > 15,
+        "{} wall contacts at most",
+        run.most_wall_contacts
+    );
+    assert!(
+        run.most_contacts > 50,
+        "{} contacts at most",
+        run.most_contacts
+    );
 }
 
 /// The host executor runs a launch's blocks in parallel: blocks of 1, 32 and 256

@@ -52,7 +52,7 @@ pub(crate) fn kick_drift(world: &mut World, dt: Real) -> usize {
 
 /// Moves every wall by its prescribed motion over `dt`, then the attached walls with
 /// their leaders, and advances the clock.
-pub(super) fn advance_walls(world: &mut World, dt: Real) {
+pub(crate) fn advance_walls(world: &mut World, dt: Real) {
     for wall in &mut world.walls {
         wall.advance(world.time, dt);
     }

@@ -55,6 +55,9 @@ pub enum DeviceError {
     /// More than the 2³² − 1 threads one launch of these kernels can index.
     #[error("{0} threads: more than one launch can index")]
     TooManyThreads(usize),
+    /// The state outgrew what the device stepper holds.
+    #[error("the device stepper holds no {0}")]
+    Capacity(String),
 }
 
 /// Holds buffers and launches kernels on them.
@@ -269,6 +272,22 @@ impl<T: Pod> Array<T> {
     pub fn write(&mut self, device: &mut dyn Device, data: &[T]) -> Result<(), DeviceError> {
         self.resize(device, data.len())?;
         device.upload(self.buffer.expect("sized"), 0, bytemuck::cast_slice(data))
+    }
+
+    /// Copies `data` in from element `first` (within the array's length).
+    pub fn write_at(
+        &mut self,
+        device: &mut dyn Device,
+        first: usize,
+        data: &[T],
+    ) -> Result<(), DeviceError> {
+        let size = size_of::<T>();
+        check_range(first * size, std::mem::size_of_val(data), self.len * size)?;
+        device.upload(
+            self.buffer.expect("sized"),
+            first * size,
+            bytemuck::cast_slice(data),
+        )
     }
 
     /// The elements.

@@ -7,14 +7,15 @@
 //! A [`device::Device`] holds buffers and launches kernels: the CUDA driver
 //! ([`driver::CudaDevice`]) or the host executor ([`device::HostDevice`]), behind
 //! one interface, so the code that drives the kernels is the same on both.
-//! [`spheres::DeviceSpheres`] steps a world of Hertz–Mindlin spheres on a device:
-//! integration, the candidate list (a hashed cell grid, pairs by prefix sum), the
-//! pair contacts with their tangential history, and the gather; it gives the CPU
-//! backend's bits through the host executor. Walls, polyhedra, the backend behind
-//! the seam and multi-GPU are to come.
+//! [`spheres::DeviceSpheres`] steps a world of Hertz–Mindlin spheres and walls on a
+//! device: integration, the candidate list (a hashed cell grid, pairs by prefix
+//! sum), the pair contacts with their tangential history, the gather, the wall
+//! contacts and the walls' sums; it gives the CPU backend's bits through the host
+//! executor. Polyhedra, the backend behind the seam and multi-GPU are to come.
 
 pub mod device;
 mod device_list;
+mod device_walls;
 pub mod driver;
 pub mod host;
 pub mod nvrtc;
@@ -27,31 +28,51 @@ pub struct KernelFile {
     pub name: &'static str,
     /// Its text.
     pub source: &'static str,
+    /// The headers it is compiled after, in order.
+    pub headers: &'static [&'static KernelFile],
 }
 
-/// The helpers every kernel file is compiled after.
-pub const HELPERS: KernelFile = KernelFile {
+/// Vectors and quaternions with nalgebra's operations: every kernel file's first
+/// header.
+pub static VEC: KernelFile = KernelFile {
     name: "vec.cuh",
     source: include_str!("../../../kernels/vec.cuh"),
+    headers: &[],
+};
+
+/// The Hertz–Mindlin law of round contacts.
+pub static CONTACT: KernelFile = KernelFile {
+    name: "contact.cuh",
+    source: include_str!("../../../kernels/contact.cuh"),
+    headers: &[],
 };
 
 /// The kernel files, each compiled to one module.
-pub static FILES: [KernelFile; 4] = [
+pub static FILES: [KernelFile; 5] = [
     KernelFile {
         name: "integrate.cu",
         source: include_str!("../../../kernels/integrate.cu"),
+        headers: &[&VEC],
     },
     KernelFile {
         name: "list.cu",
         source: include_str!("../../../kernels/list.cu"),
+        headers: &[&VEC],
     },
     KernelFile {
         name: "scan.cu",
         source: include_str!("../../../kernels/scan.cu"),
+        headers: &[&VEC],
     },
     KernelFile {
         name: "spheres.cu",
         source: include_str!("../../../kernels/spheres.cu"),
+        headers: &[&VEC, &CONTACT],
+    },
+    KernelFile {
+        name: "walls.cu",
+        source: include_str!("../../../kernels/walls.cu"),
+        headers: &[&VEC, &CONTACT],
     },
 ];
 
@@ -100,11 +121,15 @@ pub enum Kernel {
     GatherForces,
     /// The pairs that touch, counted (`spheres.cu`).
     CountTouching,
+    /// The Hertz–Mindlin contacts of spheres with wall facets (`walls.cu`).
+    SphereWalls,
+    /// The walls' forces, torques and facet forces (`walls.cu`).
+    SumWalls,
 }
 
 impl Kernel {
     /// Every kernel.
-    pub const ALL: [Kernel; 21] = [
+    pub const ALL: [Kernel; 23] = [
         Kernel::KickDrift,
         Kernel::ClosingKick,
         Kernel::BinParticles,
@@ -126,6 +151,8 @@ impl Kernel {
         Kernel::SphereContacts,
         Kernel::GatherForces,
         Kernel::CountTouching,
+        Kernel::SphereWalls,
+        Kernel::SumWalls,
     ];
 
     /// Its name in the source (`extern "C"`, so the PTX entry has it too).
@@ -152,6 +179,8 @@ impl Kernel {
             Kernel::SphereContacts => "sphere_contacts",
             Kernel::GatherForces => "gather_forces",
             Kernel::CountTouching => "count_touching",
+            Kernel::SphereWalls => "sphere_walls",
+            Kernel::SumWalls => "sum_walls",
         }
     }
 
@@ -166,6 +195,7 @@ impl Kernel {
             }
             ScanChunkTotals | ScanChunkOffsets | ScanApply | ZeroWords | CopyWords => 2,
             SphereContacts | GatherForces | CountTouching => 3,
+            SphereWalls | SumWalls => 4,
         };
         &FILES[index]
     }

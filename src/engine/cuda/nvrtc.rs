@@ -2,7 +2,7 @@
 //! `libnvrtc` at run time (the CUDA toolkit's, or PyPI's `nvidia-cuda-nvrtc-cu12`
 //! with its `lib` directory on `LD_LIBRARY_PATH`).
 
-use super::{HELPERS, KernelFile};
+use super::KernelFile;
 
 /// The GPU architectures every kernel is compiled for: Ampere (A100) and Hopper
 /// (H100, H200).
@@ -37,10 +37,19 @@ pub fn is_present() -> bool {
 
 /// The kernel file compiled to PTX for `arch` (`"sm_80"`, `"sm_90"`, ...).
 pub fn compile(file: &KernelFile, arch: &str) -> Result<String, NvrtcError> {
-    compile_source(file.name, file.source, arch)
+    let headers: String = file
+        .headers
+        .iter()
+        .map(|h| format!("#line 1 \"{}\"\n{}\n", h.name, h.source))
+        .collect();
+    compile_source(
+        file.name,
+        &format!("{headers}#line 1 \"{}\"\n{}", file.name, file.source),
+        arch,
+    )
 }
 
-/// [`compile`] of the text `source` of the file `file`: after [`HELPERS`], in double
+/// The text `source` of the file `file` compiled to PTX for `arch`, in double
 /// precision with IEEE division and square roots and without contraction into fused
 /// multiply–adds (so a kernel computes what the CPU backend computes, operation by
 /// operation).
@@ -57,9 +66,7 @@ pub fn compile_source(file: &'static str, source: &str, arch: &str) -> Result<St
         options: vec![format!("--gpu-architecture={arch}")],
         ..Default::default()
     };
-    // `#line` keeps NVRTC's messages at the file's own lines.
-    let text = format!("{}\n#line 1 \"{file}\"\n{source}", HELPERS.source);
-    cudarc::nvrtc::compile_ptx_with_opts(text, options)
+    cudarc::nvrtc::compile_ptx_with_opts(source, options)
         .map(|ptx| ptx.to_src())
         .map_err(|e| NvrtcError::Compile {
             file,

@@ -9,7 +9,11 @@
 //! word (whether the list is stale) and, when it was rebuilt, the pair count; the
 //! particles come back by [`DeviceSpheres::download`].
 //!
-//! What it does not take yet (refused by [`DeviceSpheres::new`]): walls, polyhedra,
+//! Walls (`device_walls.rs`) move on the host and are placed on the device; each
+//! particle's wall contacts follow its pairs' gather, and one thread sums the
+//! walls' forces in particle order.
+//!
+//! What it does not take yet (refused by [`DeviceSpheres::new`]): polyhedra,
 //! rolling resistance, a fluid, ghosts of a decomposition, particles not stored in
 //! the order of their ids.
 
@@ -18,6 +22,7 @@ use nalgebra::{Point3, Quaternion, UnitQuaternion, Vector3};
 use super::Kernel;
 use super::device::{Arg, Array, Device, DeviceError};
 use super::device_list::{DeviceList, ListInputs, run};
+use super::device_walls::{DeviceWalls, WallInputs};
 use crate::Real;
 use crate::contact::{RollingModel, TangentialHistory, pair_restitution};
 use crate::engine::backend::ContactHistory;
@@ -93,6 +98,7 @@ pub struct DeviceSpheres {
     particles: ParticleArrays,
     pairs: PairArrays,
     list: DeviceList,
+    walls: DeviceWalls,
     /// Pairs that touched at the last force evaluation.
     contacts: usize,
 }
@@ -120,9 +126,6 @@ impl DeviceSpheres {
             })
         {
             return unsupported("a law other than Hertz–Mindlin without rolling resistance");
-        }
-        if !world.walls.is_empty() {
-            return unsupported("walls");
         }
         if world.fluid.is_some() {
             return unsupported("a fluid");
@@ -186,6 +189,7 @@ impl DeviceSpheres {
         let skin = if skin.is_finite() { skin.max(0.0) } else { 0.0 };
         let largest = radii.iter().copied().fold(0.0, Real::max);
         let list = DeviceList::new(skin, 2.0 * largest + skin);
+        let walls = DeviceWalls::new(d, world, p.len())?;
         let mut spheres = DeviceSpheres {
             device,
             n: p.len(),
@@ -195,6 +199,7 @@ impl DeviceSpheres {
             particles: ParticleArrays::default(),
             pairs: PairArrays::default(),
             list,
+            walls,
             contacts: 0,
         };
         spheres.upload_particles(world)?;
@@ -228,8 +233,9 @@ impl DeviceSpheres {
         self.device.description()
     }
 
-    /// Bytes of device memory the stepper holds: particles, body types, the list
-    /// and the pairs' history and results (buffers have room to grow by half).
+    /// Bytes of device memory the stepper holds: particles, body types, the list,
+    /// the pairs' history and results, the walls (buffers have room to grow by
+    /// half).
     pub fn device_bytes(&self) -> usize {
         let d = self.device.as_ref();
         let (p, t, q) = (&self.particles, &self.types, &self.pairs);
@@ -259,6 +265,7 @@ impl DeviceSpheres {
                 .sum::<usize>()
             + p.id.bytes(d)
             + self.list.bytes(d)
+            + self.walls.bytes(d)
     }
 
     /// Pairs that touched at the last force evaluation.
@@ -308,7 +315,8 @@ impl DeviceSpheres {
                 ],
             )?;
         }
-        self.time += dt;
+        self.walls.advance(self.device.as_mut(), dt)?;
+        self.time = self.walls.time();
         self.forces(dt)?;
         let (d, p, t) = (self.device.as_mut(), &self.particles, &self.types);
         // SAFETY: as above, closing_kick's parameters.
@@ -442,7 +450,35 @@ impl DeviceSpheres {
             )?;
         }
         self.contacts = pairs.counter.get(d, 0)? as usize;
+        if !self.walls.is_empty() {
+            let at = WallInputs {
+                n: self.n,
+                dt,
+                position: &p.position,
+                velocity: &p.velocity,
+                orientation: &p.orientation,
+                angular_momentum: &p.angular_momentum,
+                body_type: &p.body_type,
+                frozen: &p.frozen,
+                type_radius: &t.radius,
+                type_mass: &t.mass,
+                type_inertia: &t.inertia,
+                type_material: &t.material,
+                materials: t.materials,
+                material_pairs: &t.material_pairs,
+                force: &p.force,
+                torque: &p.torque,
+                touching: &p.touching,
+            };
+            self.walls.contacts(d, &at)?;
+        }
         Ok(())
+    }
+
+    /// Particle–wall contacts at the last force evaluation (read back from the
+    /// device).
+    pub fn wall_contacts(&mut self) -> Result<usize, DeviceError> {
+        self.walls.contact_count(self.device.as_mut())
     }
 
     /// Copies the particles' state and forces, and the clock, into `world` (the
@@ -480,7 +516,7 @@ impl DeviceSpheres {
             .map(|q| UnitQuaternion::new_unchecked(Quaternion::new(q[3], q[0], q[1], q[2])))
             .collect();
         world.time = self.time;
-        Ok(())
+        self.walls.download(d, world)
     }
 
     /// Whether each particle touched another at the last force evaluation (frozen
@@ -510,9 +546,21 @@ impl DeviceSpheres {
             })
             .filter(|(_, h)| !h.is_empty())
             .collect();
-        Ok(ContactHistory {
-            pairs,
-            walls: Vec::new(),
-        })
+        let ids = self.particles.id.read(d)?;
+        let walls = self
+            .walls
+            .history(d, &ids)?
+            .into_iter()
+            .map(|(key, h)| {
+                let kept = TangentialHistory {
+                    spring: Vector3::new(h[0], h[1], h[2]),
+                    stiffness: h[3],
+                    ..Default::default()
+                };
+                (key, kept)
+            })
+            .filter(|(_, h)| !h.is_empty())
+            .collect();
+        Ok(ContactHistory { pairs, walls })
     }
 }

@@ -1,0 +1,98 @@
+// The Hertz–Mindlin law of round contacts with Cundall–Strack friction
+// (contact/hertz_mindlin.rs, contact/tangential.rs, engine/cpu/hertz.rs), shared by
+// the sphere pairs (spheres.cu) and the sphere–wall contacts (walls.cu): the CPU
+// backend's operations in its order. Compiled after vec.cuh.
+
+#define HISTORY_DOUBLES 4u
+#define RESULT_DOUBLES 11u
+#define MATERIAL_DOUBLES 5u
+
+// 2 √(5/6), the factor of the damping coefficients.
+#define DAMPING_FACTOR 1.8257418583505537
+
+struct Spring {
+    Vec3 spring;
+    double stiffness;
+};
+
+static __device__ __forceinline__ double spring_energy(Spring s) {
+    return 0.5 * s.stiffness * norm_squared(s.spring);
+}
+
+// Cundall–Strack friction (contact/tangential.rs): the force on body 2, the spring
+// kept in *kept.
+static __device__ __forceinline__ Vec3 tangential_force(Spring history, Vec3 normal,
+                                                        Vec3 relative_velocity, double dt,
+                                                        double stiffness, double damping,
+                                                        double limit, Spring* kept) {
+    Vec3 previous = history.spring;
+    Vec3 spring = sub(previous, scale(normal, dot(normal, previous)));
+    double projected = norm_squared(spring);
+    if (projected > 0.0) {
+        double keep = history.stiffness > 0.0 && stiffness > history.stiffness
+                          ? history.stiffness / stiffness
+                          : 1.0;
+        spring = scale(spring, keep * sqrt(norm_squared(previous) / projected));
+    }
+    Vec3 vt = sub(relative_velocity, scale(normal, dot(normal, relative_velocity)));
+    spring = add(spring, scale(vt, dt));
+    Vec3 trial = sub(scale(spring, -stiffness), scale(vt, damping));
+    double squared = norm_squared(trial);
+    if (squared <= limit * limit || squared == 0.0) {
+        *kept = Spring{spring, stiffness};
+        return trial;
+    }
+    double magnitude = sqrt(squared);
+    Vec3 force = scale(trial, limit / magnitude);
+    double length = norm(spring);
+    if (stiffness > 0.0 && stiffness * length > limit) {
+        spring = scale(spring, limit / (stiffness * length));
+    }
+    *kept = Spring{spring, stiffness};
+    return force;
+}
+
+// What a round contact puts on body 2: force, torque about its centroid, the
+// friction spring to keep, the elastic energy held and the energy dissipated.
+struct RoundContact {
+    Vec3 force, torque;
+    Spring kept;
+    double energy, dissipated;
+};
+
+// A Hertz–Mindlin contact of `depth` along `normal` (from body 1 to body 2), at
+// `lever` from body 2's centroid, with the relative velocity at the contact point,
+// the relative spin, the inverse effective mass, the effective radius and the
+// material pair's row `m` (engine/cpu/hertz.rs `round_contact_force`, without
+// rolling resistance).
+static __device__ RoundContact round_contact(double depth, Vec3 normal, Vec3 lever,
+                                             Vec3 relative, Vec3 spin, double inverse_mass,
+                                             double radius, const double* m, Spring before,
+                                             double dt) {
+    double young = m[0], shear = m[1], beta = m[2], damping_ratio = m[3], friction = m[4];
+    // Hertz–Mindlin (contact/hertz_mindlin.rs).
+    double mass = 1.0 / inverse_mass;
+    double a = sqrt(radius * depth);
+    double tangent = 2.0 * young * a;
+    double stiffness = (2.0 / 3.0) * tangent;
+    double elastic = stiffness * depth;
+    double damping_n = -DAMPING_FACTOR * beta * sqrt(tangent * mass);
+    double vn = dot(relative, normal);
+    double normal_force = fmax(elastic - damping_n * vn, 0.0);
+    double kt = 8.0 * shear * a;
+    double damping_t = damping_n * damping_ratio;
+    RoundContact c;
+    Vec3 t = tangential_force(before, normal, relative, dt, kt, damping_t,
+                              friction * normal_force, &c.kept);
+    c.force = add(scale(normal, normal_force), t);
+    c.torque = cross(lever, c.force);
+    c.energy = 0.4 * elastic * depth + spring_energy(c.kept);
+    // Energy dissipated over the step (engine/cpu/forces.rs `dissipated`): the work
+    // of the force less its elastic normal part at the step's end velocity.
+    Vec3 damping = sub(c.force, scale(normal, elastic));
+    Vec3 moved = add(relative, scale(c.force, 0.5 * dt * inverse_mass));
+    c.dissipated = -dt * (dot(damping, moved) + dot(Vec3{0.0, 0.0, 0.0}, spin)) -
+                   (spring_energy(c.kept) - spring_energy(before));
+    return c;
+}
+

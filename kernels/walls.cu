@@ -1,0 +1,269 @@
+// The Hertz–Mindlin contacts of spheres with wall facets (engine/cpu/walls.rs,
+// engine/cpu/patch.rs, geometry/sphere.rs): one thread per particle, every wall's
+// facets tested (no facet list yet: O(particles × facets)), the facets of one
+// plane merged into one contact at the deepest, the contacts added to the
+// particle's force and torque in wall and patch order after the pairs' gather;
+// then one thread sums the walls' forces, torques and facet forces in particle
+// order. The CPU backend's operations in its order, so the same bits.
+//
+// Layouts: facets of all walls one after the other, wall w's from
+// wall_facets[w] to wall_facets[w + 1]: placed corners (9 doubles) and unit
+// normals (3). Per wall: its material, and velocity, angular velocity and
+// reference point (9 doubles). Per particle WALL_SLOTS contacts: the key (wall,
+// and the plane's four rounded numbers: 5 long longs), the friction spring (4
+// doubles), and for the sums the force, the torque and the facet's share
+// (7 doubles) and the facet; the count of contacts.
+
+#define WALL_SLOTS 4u
+#define KEY_WORDS 5u
+#define RECORD_DOUBLES 7u
+
+static __device__ __forceinline__ Vec3 closest_on_triangle(Vec3 a, Vec3 b, Vec3 c, Vec3 p) {
+    Vec3 ab = sub(b, a), ac = sub(c, a), ap = sub(p, a);
+    double d1 = dot(ab, ap), d2 = dot(ac, ap);
+    if (d1 <= 0.0 && d2 <= 0.0) {
+        return a;
+    }
+    Vec3 bp = sub(p, b);
+    double d3 = dot(ab, bp), d4 = dot(ac, bp);
+    if (d3 >= 0.0 && d4 <= d3) {
+        return b;
+    }
+    double vc = d1 * d4 - d3 * d2;
+    if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) {
+        return add(a, scale(ab, d1 / (d1 - d3)));
+    }
+    Vec3 cp = sub(p, c);
+    double d5 = dot(ab, cp), d6 = dot(ac, cp);
+    if (d6 >= 0.0 && d5 <= d6) {
+        return c;
+    }
+    double vb = d5 * d2 - d1 * d6;
+    if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) {
+        return add(a, scale(ac, d2 / (d2 - d6)));
+    }
+    double va = d3 * d6 - d5 * d4;
+    if (va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0) {
+        double w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        return add(b, scale(sub(c, b), w));
+    }
+    double denom = 1.0 / (va + vb + vc);
+    return add(add(a, scale(ab, vb * denom)), scale(ac, vc * denom));
+}
+
+// A sphere's contact with one facet, as geometry/sphere.rs `sphere_triangle`
+// and engine/cpu/dispatch.rs give it.
+struct FacetContact {
+    double depth, volume, area;
+    Vec3 normal, point;
+};
+
+static __device__ __forceinline__ bool sphere_facet(const double* t, Vec3 centre, double r,
+                                                    FacetContact* out) {
+    Vec3 a = load3(t, 0), b = load3(t, 1), c = load3(t, 2);
+    Vec3 q = closest_on_triangle(a, b, c, centre);
+    Vec3 offset = sub(centre, q);
+    double distance = norm(offset);
+    if (distance >= r) {
+        return false;
+    }
+    Vec3 normal;
+    if (distance > 0.0) {
+        normal = Vec3{offset.x / distance, offset.y / distance, offset.z / distance};
+    } else {
+        Vec3 n = cross(sub(b, a), sub(c, a));
+        double l = norm(n);
+        normal = Vec3{n.x / l, n.y / l, n.z / l};
+    }
+    double depth = r - distance;
+    const double pi = 3.14159265358979323846;
+    double hv = fmin(fmax(depth, 0.0), 2.0 * r);
+    double ha = fmin(fmax(depth, 0.0), r);
+    out->depth = depth;
+    out->normal = normal;
+    out->point = sub(q, scale(normal, 0.5 * depth));
+    out->volume = pi * hv * hv * (3.0 * r - hv) / 3.0;
+    out->area = pi * (2.0 * r * ha - ha * ha);
+    return true;
+}
+
+// The plane key of engine/cpu/patch.rs `plane_key`.
+static __device__ __forceinline__ void plane_key(Vec3 n, Vec3 point, double radius,
+                                                 long long* key) {
+    key[0] = (long long)round(n.x * 1e9);
+    key[1] = (long long)round(n.y * 1e9);
+    key[2] = (long long)round(n.z * 1e9);
+    key[3] = (long long)round(dot(n, point) / radius * 1e9);
+}
+
+// One thread per particle: its wall contacts (see the file's head). `overflow`
+// is set when a particle has more than WALL_SLOTS contacts.
+extern "C" __global__ void sphere_walls(
+    unsigned n, double dt, const double* position, const double* velocity,
+    const double* orientation, const double* angular_momentum, const unsigned* body_type,
+    const unsigned char* frozen, const double* type_radius, const double* type_mass,
+    const double* type_inertia, const unsigned* type_material, unsigned materials,
+    const double* material_pairs, unsigned walls, const unsigned* wall_facets,
+    const double* facets, const double* facet_normals, const unsigned* wall_material,
+    const double* wall_motion, const unsigned* old_count, const long long* old_keys,
+    const double* old_springs, unsigned* count, long long* keys, double* springs,
+    double* records, unsigned* record_facet, double* force, double* torque,
+    unsigned char* touching, unsigned* overflow) {
+    unsigned i = blockIdx.x * blockDim.x + threadIdx.x;
+    if (i >= n) {
+        return;
+    }
+    count[i] = 0;
+    if (frozen[i]) {
+        return;
+    }
+    unsigned kind = body_type[i];
+    double r = type_radius[kind];
+    Vec3 x = load3(position, i);
+    Vec3 l = load3(angular_momentum, i);
+    Vec3 inertia = load3(type_inertia, kind);
+    Quat q = Quat{orientation[4 * i + 3], orientation[4 * i], orientation[4 * i + 1],
+                  orientation[4 * i + 2]};
+    // World::angular_velocity of an isotropic body: L / I.
+    Vec3 spin = Vec3{l.x / inertia.x, l.y / inertia.x, l.z / inertia.x};
+    Vec3 f = load3(force, i), t = load3(torque, i);
+    unsigned made = 0;
+    for (unsigned w = 0; w < walls; ++w) {
+        // The patches of this wall: key, the deepest facet's contact, its facet and
+        // share.
+        long long patch_key[WALL_SLOTS][4];
+        FacetContact patch[WALL_SLOTS];
+        unsigned patch_facet[WALL_SLOTS];
+        double patch_share[WALL_SLOTS];
+        unsigned patches = 0;
+        for (unsigned k = wall_facets[w]; k < wall_facets[w + 1]; ++k) {
+            const double* tri = facets + 9 * k;
+            Vec3 nrm = load3(facet_normals, k);
+            double height = dot(nrm, sub(x, load3(tri, 0)));
+            if (!(height >= 0.0 && height <= r)) {
+                continue;
+            }
+            FacetContact g;
+            if (!sphere_facet(tri, x, r, &g)) {
+                continue;
+            }
+            long long key[4];
+            plane_key(nrm, load3(tri, 0), r, key);
+            unsigned p = 0;
+            while (p < patches && !(patch_key[p][0] == key[0] && patch_key[p][1] == key[1] &&
+                                    patch_key[p][2] == key[2] && patch_key[p][3] == key[3])) {
+                ++p;
+            }
+            if (p == patches) {
+                if (patches == WALL_SLOTS) {
+                    atomicOr(overflow, 1u);
+                    continue;
+                }
+                for (int c = 0; c < 4; ++c) {
+                    patch_key[p][c] = key[c];
+                }
+                patch[p] = g;
+                patch_facet[p] = k;
+                patch_share[p] = g.volume;
+                ++patches;
+            } else if (g.depth > patch[p].depth) {
+                patch[p] = g;
+                patch_facet[p] = k;
+                patch_share[p] = 1.0;
+            }
+        }
+        const double* wm = wall_motion + 9 * w;
+        Vec3 wall_velocity = load3(wm, 0), wall_spin = load3(wm, 1), reference = load3(wm, 2);
+        const double* m =
+            material_pairs + MATERIAL_DOUBLES * (type_material[kind] * materials + wall_material[w]);
+        for (unsigned p = 0; p < patches; ++p) {
+            FacetContact g = patch[p];
+            bool finite = isfinite(g.normal.x) && isfinite(g.normal.y) && isfinite(g.normal.z);
+            if (!(g.area > 0.0) || !finite) {
+                continue;
+            }
+            if (made == WALL_SLOTS) {
+                atomicOr(overflow, 1u);
+                break;
+            }
+            // RelativeMotion::of_wall.
+            Vec3 lever = sub(g.point, x);
+            Vec3 at = add(load3(velocity, i), cross(spin, lever));
+            Vec3 wall_at = add(wall_velocity, cross(wall_spin, sub(g.point, reference)));
+            Vec3 relative = sub(at, wall_at);
+            Vec3 arm = rotate(conjugate(q), cross(lever, g.normal));
+            Vec3 scaled = Vec3{arm.x / inertia.x, arm.y / inertia.y, arm.z / inertia.z};
+            double inverse_mass = 1.0 / type_mass[kind] + dot(scaled, arm);
+            // The patch's spring of the last step, found by its key.
+            long long* key = keys + KEY_WORDS * (WALL_SLOTS * i + made);
+            key[0] = w;
+            for (int c = 0; c < 4; ++c) {
+                key[1 + c] = patch_key[p][c];
+            }
+            Spring before = Spring{Vec3{0.0, 0.0, 0.0}, 0.0};
+            for (unsigned s = 0; s < old_count[i]; ++s) {
+                const long long* o = old_keys + KEY_WORDS * (WALL_SLOTS * i + s);
+                if (o[0] == key[0] && o[1] == key[1] && o[2] == key[2] && o[3] == key[3] &&
+                    o[4] == key[4]) {
+                    const double* h = old_springs + HISTORY_DOUBLES * (WALL_SLOTS * i + s);
+                    before = Spring{load3(h, 0), h[3]};
+                }
+            }
+            RoundContact c = round_contact(g.depth, g.normal, lever, relative,
+                                           sub(spin, wall_spin), inverse_mass, r, m, before, dt);
+            double* h = springs + HISTORY_DOUBLES * (WALL_SLOTS * i + made);
+            store3(h, 0, c.kept.spring);
+            h[3] = c.kept.stiffness;
+            double* record = records + RECORD_DOUBLES * (WALL_SLOTS * i + made);
+            store3(record, 0, c.force);
+            store3(record, 1, c.torque);
+            record[6] = patch_share[p];
+            record_facet[WALL_SLOTS * i + made] = patch_facet[p];
+            f = add(f, c.force);
+            t = add(t, c.torque);
+            touching[i] = 1;
+            ++made;
+        }
+    }
+    count[i] = made;
+    store3(force, i, f);
+    store3(torque, i, t);
+}
+
+// One thread: every wall's force, torque and facet forces, summed over the
+// particles' wall contacts in particle order.
+extern "C" __global__ void sum_walls(unsigned n, const double* position, unsigned walls,
+                                     const unsigned* wall_facets, const double* wall_motion,
+                                     const unsigned* count, const long long* keys,
+                                     const double* records, const unsigned* record_facet,
+                                     double* wall_force, double* wall_torque,
+                                     double* facet_force) {
+    if (blockIdx.x * blockDim.x + threadIdx.x != 0) {
+        return;
+    }
+    for (unsigned w = 0; w < walls; ++w) {
+        store3(wall_force, w, Vec3{0.0, 0.0, 0.0});
+        store3(wall_torque, w, Vec3{0.0, 0.0, 0.0});
+    }
+    for (unsigned k = 0; k < wall_facets[walls]; ++k) {
+        store3(facet_force, k, Vec3{0.0, 0.0, 0.0});
+    }
+    for (unsigned i = 0; i < n; ++i) {
+        Vec3 x = load3(position, i);
+        for (unsigned s = 0; s < count[i]; ++s) {
+            unsigned slot = WALL_SLOTS * i + s;
+            unsigned w = (unsigned)keys[KEY_WORDS * slot];
+            const double* record = records + RECORD_DOUBLES * slot;
+            Vec3 f = load3(record, 0), t = load3(record, 1);
+            Vec3 reference = load3(wall_motion + 9 * w, 2);
+            store3(wall_force, w, sub(load3(wall_force, w), f));
+            Vec3 reaction = scale(add(t, cross(sub(x, reference), f)), -1.0);
+            store3(wall_torque, w, add(load3(wall_torque, w), reaction));
+            double share = record[6];
+            if (share > 0.0) {
+                unsigned facet = record_facet[slot];
+                store3(facet_force, facet, sub(load3(facet_force, facet), scale(f, share / share)));
+            }
+        }
+    }
+}

@@ -1,0 +1,359 @@
+//! The walls of a world of spheres on a device (`kernels/walls.cu`): their facets
+//! as placed in the world, their motion, each particle's contacts with them and
+//! their friction springs, and the walls' forces.
+//!
+//! The walls move on the host, by the CPU backend's own stage (their motions are
+//! prescribed or set from outside, a few numbers a step): a copy of the world
+//! without particles is advanced each step, and a wall whose pose changed has its
+//! facets placed again and uploaded with its velocities.
+
+use nalgebra::{Isometry3, Point3, Vector3};
+
+use super::Kernel;
+use super::device::{Arg, Array, Device, DeviceError};
+use super::device_list::run;
+use crate::Real;
+use crate::engine::backend::WallKey;
+use crate::engine::cpu::motion::advance_walls;
+use crate::world::World;
+
+/// Contacts a particle may have with the walls at once (`WALL_SLOTS` of walls.cu).
+pub(super) const SLOTS: usize = 4;
+/// Words of a contact's key: the wall and the plane's four rounded numbers.
+const KEY: usize = 5;
+/// Doubles of a contact's friction spring.
+const SPRING: usize = 4;
+/// Doubles of a contact's record for the sums.
+const RECORD: usize = 7;
+
+/// One set of per-particle contact slots: counts, keys, springs.
+#[derive(Debug, Default)]
+struct Slots {
+    count: Array<u32>,
+    keys: Array<i64>,
+    springs: Array<Real>,
+}
+
+/// The walls on a device and their host copy (see the module).
+#[derive(Debug)]
+pub(super) struct DeviceWalls {
+    /// The world's walls, materials and clock, without particles: what moves them.
+    host: World,
+    /// The pose each wall's facets were placed at.
+    placed: Vec<Option<Isometry3<Real>>>,
+    wall_facets: Array<u32>,
+    facets: Array<Real>,
+    normals: Array<Real>,
+    material: Array<u32>,
+    /// Per wall: velocity, angular velocity, reference point.
+    motion: Array<Real>,
+    old: Slots,
+    new: Slots,
+    records: Array<Real>,
+    record_facet: Array<u32>,
+    overflow: Array<u32>,
+    force: Array<Real>,
+    torque: Array<Real>,
+    facet_force: Array<Real>,
+}
+
+/// What the wall kernel reads of the particles and their types.
+pub(super) struct WallInputs<'a> {
+    pub n: usize,
+    pub dt: Real,
+    pub position: &'a Array<Real>,
+    pub velocity: &'a Array<Real>,
+    pub orientation: &'a Array<Real>,
+    pub angular_momentum: &'a Array<Real>,
+    pub body_type: &'a Array<u32>,
+    pub frozen: &'a Array<u8>,
+    pub type_radius: &'a Array<Real>,
+    pub type_mass: &'a Array<Real>,
+    pub type_inertia: &'a Array<Real>,
+    pub type_material: &'a Array<u32>,
+    pub materials: u32,
+    pub material_pairs: &'a Array<Real>,
+    pub force: &'a Array<Real>,
+    pub torque: &'a Array<Real>,
+    pub touching: &'a Array<u8>,
+}
+
+impl DeviceWalls {
+    /// The walls of `world`, placed and uploaded, for `n` particles.
+    pub fn new(device: &mut dyn Device, world: &World, n: usize) -> Result<Self, DeviceError> {
+        let mut host = world.clone();
+        host.particles = Default::default();
+        host.fluid = None;
+        let mut starts = vec![0u32];
+        for wall in &host.walls {
+            starts.push(starts[starts.len() - 1] + wall.triangles.len() as u32);
+        }
+        let facets = *starts.last().expect("a start") as usize;
+        let mut walls = DeviceWalls {
+            placed: vec![None; host.walls.len()],
+            wall_facets: Array::default(),
+            facets: Array::default(),
+            normals: Array::default(),
+            material: Array::default(),
+            motion: Array::default(),
+            old: Slots::default(),
+            new: Slots::default(),
+            records: Array::default(),
+            record_facet: Array::default(),
+            overflow: Array::default(),
+            force: Array::default(),
+            torque: Array::default(),
+            facet_force: Array::default(),
+            host,
+        };
+        walls.wall_facets.write(device, &starts)?;
+        if walls.host.walls.is_empty() {
+            return Ok(walls);
+        }
+        let materials: Vec<u32> = walls.host.walls.iter().map(|w| w.material as u32).collect();
+        walls.material.write(device, &materials)?;
+        walls.facets.resize(device, 9 * facets)?;
+        walls.normals.resize(device, 3 * facets)?;
+        walls.facet_force.resize(device, 3 * facets)?;
+        let count = walls.host.walls.len();
+        walls.motion.resize(device, 9 * count)?;
+        walls.force.resize(device, 3 * count)?;
+        walls.torque.resize(device, 3 * count)?;
+        walls.overflow.resize(device, 1)?;
+        for slots in [&mut walls.old, &mut walls.new] {
+            slots.count.resize(device, n)?;
+            slots.keys.resize(device, KEY * SLOTS * n)?;
+            slots.springs.resize(device, SPRING * SLOTS * n)?;
+        }
+        walls.records.resize(device, RECORD * SLOTS * n)?;
+        walls.record_facet.resize(device, SLOTS * n)?;
+        walls.upload_placement(device)?;
+        Ok(walls)
+    }
+
+    /// Bytes of device memory the walls hold: their facets and, per particle,
+    /// [`SLOTS`] contacts (two sets of keys and springs, and the records).
+    pub fn bytes(&self, device: &dyn Device) -> usize {
+        let doubles = [
+            &self.facets,
+            &self.normals,
+            &self.motion,
+            &self.old.springs,
+            &self.new.springs,
+            &self.records,
+            &self.force,
+            &self.torque,
+            &self.facet_force,
+        ];
+        let words = [
+            &self.wall_facets,
+            &self.material,
+            &self.old.count,
+            &self.new.count,
+            &self.record_facet,
+            &self.overflow,
+        ];
+        doubles.iter().map(|a| a.bytes(device)).sum::<usize>()
+            + words.iter().map(|a| a.bytes(device)).sum::<usize>()
+            + self.old.keys.bytes(device)
+            + self.new.keys.bytes(device)
+    }
+
+    /// Whether there are walls.
+    pub fn is_empty(&self) -> bool {
+        self.host.walls.is_empty()
+    }
+
+    /// The walls' clock.
+    pub fn time(&self) -> Real {
+        self.host.time
+    }
+
+    /// Moves the walls over `dt` (the CPU backend's stage) and uploads what moved.
+    pub fn advance(&mut self, device: &mut dyn Device, dt: Real) -> Result<(), DeviceError> {
+        advance_walls(&mut self.host, dt);
+        self.upload_placement(device)
+    }
+
+    /// Places the facets of every wall whose pose changed (as the CPU backend's wall
+    /// stage places them: corners by the pose, unit normals of the placed corners)
+    /// and uploads them, and every wall's velocities and reference point.
+    fn upload_placement(&mut self, device: &mut dyn Device) -> Result<(), DeviceError> {
+        let mut motion = Vec::with_capacity(9 * self.host.walls.len());
+        let mut first = 0;
+        for (w, wall) in self.host.walls.iter().enumerate() {
+            let reference = wall.reference();
+            motion.extend(
+                wall.velocity
+                    .iter()
+                    .chain(wall.angular_velocity.iter())
+                    .copied(),
+            );
+            motion.extend(reference.coords.iter().copied());
+            let facets = wall.triangles.len();
+            if self.placed[w] != Some(wall.pose) {
+                self.placed[w] = Some(wall.pose);
+                let triangles: Vec<[Point3<Real>; 3]> =
+                    (0..facets).map(|f| wall.facet_world(f)).collect();
+                let corners: Vec<Real> = triangles
+                    .iter()
+                    .flat_map(|t| t.iter().flat_map(|p| p.coords.iter().copied()))
+                    .collect();
+                let normals: Vec<Real> = triangles
+                    .iter()
+                    .flat_map(|t| {
+                        let n: Vector3<Real> = (t[1] - t[0]).cross(&(t[2] - t[0])).normalize();
+                        [n.x, n.y, n.z]
+                    })
+                    .collect();
+                self.facets.write_at(device, 9 * first, &corners)?;
+                self.normals.write_at(device, 3 * first, &normals)?;
+            }
+            first += facets;
+        }
+        self.motion.write(device, &motion)
+    }
+
+    /// The particles' wall contacts, added to their forces and torques (after the
+    /// pairs' gather), and the walls' sums. Fails when a particle has more than
+    /// [`SLOTS`] wall contacts.
+    pub fn contacts(
+        &mut self,
+        device: &mut dyn Device,
+        at: &WallInputs,
+    ) -> Result<(), DeviceError> {
+        std::mem::swap(&mut self.old, &mut self.new);
+        let (old, new) = (&self.old, &self.new);
+        let walls = Arg::U32(self.host.walls.len() as u32);
+        // SAFETY: the parameters of sphere_walls and sum_walls (walls.cu), every
+        // array sized for its particles, slots, walls or facets.
+        unsafe {
+            run(
+                device,
+                Kernel::ZeroWords,
+                1,
+                &[Arg::U32(1), self.overflow.arg()],
+            )?;
+            run(
+                device,
+                Kernel::SphereWalls,
+                at.n,
+                &[
+                    Arg::U32(at.n as u32),
+                    Arg::F64(at.dt),
+                    at.position.arg(),
+                    at.velocity.arg(),
+                    at.orientation.arg(),
+                    at.angular_momentum.arg(),
+                    at.body_type.arg(),
+                    at.frozen.arg(),
+                    at.type_radius.arg(),
+                    at.type_mass.arg(),
+                    at.type_inertia.arg(),
+                    at.type_material.arg(),
+                    Arg::U32(at.materials),
+                    at.material_pairs.arg(),
+                    walls,
+                    self.wall_facets.arg(),
+                    self.facets.arg(),
+                    self.normals.arg(),
+                    self.material.arg(),
+                    self.motion.arg(),
+                    old.count.arg(),
+                    old.keys.arg(),
+                    old.springs.arg(),
+                    new.count.arg(),
+                    new.keys.arg(),
+                    new.springs.arg(),
+                    self.records.arg(),
+                    self.record_facet.arg(),
+                    at.force.arg(),
+                    at.torque.arg(),
+                    at.touching.arg(),
+                    self.overflow.arg(),
+                ],
+            )?;
+            run(
+                device,
+                Kernel::SumWalls,
+                1,
+                &[
+                    Arg::U32(at.n as u32),
+                    at.position.arg(),
+                    walls,
+                    self.wall_facets.arg(),
+                    self.motion.arg(),
+                    new.count.arg(),
+                    new.keys.arg(),
+                    self.records.arg(),
+                    self.record_facet.arg(),
+                    self.force.arg(),
+                    self.torque.arg(),
+                    self.facet_force.arg(),
+                ],
+            )?;
+        }
+        if self.overflow.get(device, 0)? != 0 {
+            return Err(DeviceError::Capacity(format!(
+                "sphere touching walls at more than {SLOTS} places at once"
+            )));
+        }
+        Ok(())
+    }
+
+    /// Wall contacts at the last evaluation.
+    pub fn contact_count(&self, device: &mut dyn Device) -> Result<usize, DeviceError> {
+        Ok(self
+            .new
+            .count
+            .read(device)?
+            .iter()
+            .map(|&c| c as usize)
+            .sum())
+    }
+
+    /// Copies the walls' poses, velocities, forces, torques and facet forces into
+    /// `world`.
+    pub fn download(&self, device: &mut dyn Device, world: &mut World) -> Result<(), DeviceError> {
+        let (force, torque) = (self.force.read(device)?, self.torque.read(device)?);
+        let facet_force = self.facet_force.read(device)?;
+        let mut first = 0;
+        for (w, (wall, moved)) in world.walls.iter_mut().zip(&self.host.walls).enumerate() {
+            wall.pose = moved.pose;
+            wall.velocity = moved.velocity;
+            wall.angular_velocity = moved.angular_velocity;
+            wall.force = Vector3::from_column_slice(&force[3 * w..3 * w + 3]);
+            wall.torque = Vector3::from_column_slice(&torque[3 * w..3 * w + 3]);
+            for (f, out) in wall.facet_force.iter_mut().enumerate() {
+                let k = 3 * (first + f);
+                *out = Vector3::from_column_slice(&facet_force[k..k + 3]);
+            }
+            first += wall.triangles.len();
+        }
+        Ok(())
+    }
+
+    /// The patches' friction springs by key, for particles of `ids`.
+    pub fn history(
+        &self,
+        device: &mut dyn Device,
+        ids: &[u64],
+    ) -> Result<Vec<(WallKey, [Real; 4])>, DeviceError> {
+        let (count, keys) = (self.new.count.read(device)?, self.new.keys.read(device)?);
+        let springs = self.new.springs.read(device)?;
+        let mut out = Vec::new();
+        for (i, &c) in count.iter().enumerate() {
+            for s in 0..c as usize {
+                let slot = SLOTS * i + s;
+                let k = &keys[KEY * slot..KEY * slot + KEY];
+                let h = &springs[SPRING * slot..SPRING * slot + SPRING];
+                out.push((
+                    (ids[i], k[0] as u32, [k[1], k[2], k[3], k[4]]),
+                    [h[0], h[1], h[2], h[3]],
+                ));
+            }
+        }
+        out.sort_by_key(|e| e.0);
+        Ok(out)
+    }
+}
