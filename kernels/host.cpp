@@ -59,7 +59,7 @@ static const Entry kernels[] = {
     KERNEL(copy_doubles),      KERNEL(scan_chunk_totals), KERNEL(scan_chunk_offsets),
     KERNEL(scan_apply),        KERNEL(zero_words),       KERNEL(copy_words),
     KERNEL(sphere_contacts),   KERNEL(gather_forces),    KERNEL(count_touching),
-    KERNEL(sphere_walls),      KERNEL(sum_walls),
+    KERNEL(sphere_walls),      KERNEL(sum_walls),        KERNEL(sum_energies),
 };
 
 // The trampoline of the kernel named `name`, or null.

@@ -11,12 +11,13 @@
 // normals (3). Per wall: its material, and velocity, angular velocity and
 // reference point (9 doubles). Per particle WALL_SLOTS contacts: the key (wall,
 // and the plane's four rounded numbers: 5 long longs), the friction spring (4
-// doubles), and for the sums the force, the torque and the facet's share
-// (7 doubles) and the facet; the count of contacts.
+// doubles), and for the sums the force, the torque, the facet's share, the
+// elastic energy and the energy dissipated (9 doubles) and the facet; the count of
+// contacts.
 
 #define WALL_SLOTS 4u
 #define KEY_WORDS 5u
-#define RECORD_DOUBLES 7u
+#define RECORD_DOUBLES 9u
 
 static __device__ __forceinline__ Vec3 closest_on_triangle(Vec3 a, Vec3 b, Vec3 c, Vec3 p) {
     Vec3 ab = sub(b, a), ac = sub(c, a), ap = sub(p, a);
@@ -218,6 +219,8 @@ extern "C" __global__ void sphere_walls(
             store3(record, 0, c.force);
             store3(record, 1, c.torque);
             record[6] = patch_share[p];
+            record[7] = c.energy;
+            record[8] = c.dissipated;
             record_facet[WALL_SLOTS * i + made] = patch_facet[p];
             f = add(f, c.force);
             t = add(t, c.torque);
@@ -266,4 +269,75 @@ extern "C" __global__ void sum_walls(unsigned n, const double* position, unsigne
             }
         }
     }
+}
+
+// One thread: the elastic energy held in the contacts and the energy they
+// dissipated over the step, summed as the CPU backend sums them
+// (engine/cpu/pairs.rs `gather`, engine/cpu/walls.rs): the pairs in pair order,
+// then the wall contacts in particle order, then the springs of the wall contacts
+// that ended (in a slot of the last step, not in this one's), in the order of their
+// keys, added as one sum. Into totals[0] (energy) and totals[1] (dissipated).
+extern "C" __global__ void sum_energies(unsigned pair_count, const double* results, unsigned n,
+                                        unsigned walls, const unsigned* count,
+                                        const long long* keys, const double* records,
+                                        const unsigned* old_count, const long long* old_keys,
+                                        const double* old_springs, double* totals) {
+    if (blockIdx.x * blockDim.x + threadIdx.x != 0) {
+        return;
+    }
+    double energy = 0.0, dissipated = 0.0;
+    for (unsigned e = 0; e < pair_count; ++e) {
+        energy += results[RESULT_DOUBLES * e + 9];
+        dissipated += results[RESULT_DOUBLES * e + 10];
+    }
+    if (walls > 0) {
+        for (unsigned i = 0; i < n; ++i) {
+            for (unsigned s = 0; s < count[i]; ++s) {
+                const double* record = records + RECORD_DOUBLES * (WALL_SLOTS * i + s);
+                energy += record[7];
+                dissipated += record[8];
+            }
+        }
+        double ended = -0.0;
+        for (unsigned i = 0; i < n; ++i) {
+            // The ended slots of particle i, in the order of their keys.
+            unsigned order[WALL_SLOTS];
+            unsigned m = 0;
+            for (unsigned s = 0; s < old_count[i]; ++s) {
+                const long long* o = old_keys + KEY_WORDS * (WALL_SLOTS * i + s);
+                bool kept = false;
+                for (unsigned t = 0; t < count[i]; ++t) {
+                    const long long* k = keys + KEY_WORDS * (WALL_SLOTS * i + t);
+                    bool same = true;
+                    for (unsigned c = 0; c < KEY_WORDS; ++c) {
+                        same = same && o[c] == k[c];
+                    }
+                    kept = kept || same;
+                }
+                if (kept) {
+                    continue;
+                }
+                unsigned at = m++;
+                for (; at > 0; --at) {
+                    const long long* a = old_keys + KEY_WORDS * (WALL_SLOTS * i + order[at - 1]);
+                    unsigned c = 0;
+                    while (c < KEY_WORDS && a[c] == o[c]) {
+                        ++c;
+                    }
+                    if (c == KEY_WORDS || a[c] < o[c]) {
+                        break;
+                    }
+                    order[at] = order[at - 1];
+                }
+                order[at] = s;
+            }
+            for (unsigned k = 0; k < m; ++k) {
+                const double* h = old_springs + HISTORY_DOUBLES * (WALL_SLOTS * i + order[k]);
+                ended += spring_energy(Spring{load3(h, 0), h[3]});
+            }
+        }
+        dissipated += ended;
+    }
+    totals[0] = energy;
+    totals[1] = dissipated;
 }

@@ -204,6 +204,12 @@ fn parity(
         let history = cpu.contact_history();
         assert_eq!(spheres.contact_history().unwrap(), history, "step {step}");
         most_springs = most_springs.max(history.pairs.len() + history.walls.len());
+        let energies = (cpu.stats().elastic_energy, cpu.stats().dissipated);
+        assert_eq!(
+            spheres.energies().unwrap(),
+            energies,
+            "energies at step {step}"
+        );
         let wall_contacts = cpu.stats().contacts - cpu.stats().pair_contacts;
         assert_eq!(
             spheres.wall_contacts().unwrap(),

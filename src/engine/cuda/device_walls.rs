@@ -24,7 +24,7 @@ const KEY: usize = 5;
 /// Doubles of a contact's friction spring.
 const SPRING: usize = 4;
 /// Doubles of a contact's record for the sums.
-const RECORD: usize = 7;
+const RECORD: usize = 9;
 
 /// One set of per-particle contact slots: counts, keys, springs.
 #[derive(Debug, Default)]
@@ -107,9 +107,9 @@ impl DeviceWalls {
             host,
         };
         walls.wall_facets.write(device, &starts)?;
-        if walls.host.walls.is_empty() {
-            return Ok(walls);
-        }
+        // Without walls the per-particle slots hold nothing (the energy sum still
+        // takes them as arguments).
+        let n = if walls.host.walls.is_empty() { 0 } else { n };
         let materials: Vec<u32> = walls.host.walls.iter().map(|w| w.material as u32).collect();
         walls.material.write(device, &materials)?;
         walls.facets.resize(device, 9 * facets)?;
@@ -299,6 +299,45 @@ impl DeviceWalls {
             )));
         }
         Ok(())
+    }
+
+    /// Launches the sum of the contacts' elastic energy and dissipation over the
+    /// pairs' `results` (`pairs` of them) and the walls' contacts into `totals`.
+    pub fn sum_energies(
+        &self,
+        device: &mut dyn Device,
+        n: usize,
+        pairs: usize,
+        results: &Array<Real>,
+        totals: &Array<Real>,
+    ) -> Result<(), DeviceError> {
+        let walls = if self.is_empty() {
+            0
+        } else {
+            self.host.walls.len()
+        };
+        // SAFETY: the parameters of sum_energies (walls.cu); the slots hold n
+        // particles' where there are walls.
+        unsafe {
+            run(
+                device,
+                Kernel::SumEnergies,
+                1,
+                &[
+                    Arg::U32(pairs as u32),
+                    results.arg(),
+                    Arg::U32(n as u32),
+                    Arg::U32(walls as u32),
+                    self.new.count.arg(),
+                    self.new.keys.arg(),
+                    self.records.arg(),
+                    self.old.count.arg(),
+                    self.old.keys.arg(),
+                    self.old.springs.arg(),
+                    totals.arg(),
+                ],
+            )
+        }
     }
 
     /// Wall contacts at the last evaluation.

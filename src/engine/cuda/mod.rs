@@ -125,11 +125,13 @@ pub enum Kernel {
     SphereWalls,
     /// The walls' forces, torques and facet forces (`walls.cu`).
     SumWalls,
+    /// The contacts' elastic energy and dissipation, summed (`walls.cu`).
+    SumEnergies,
 }
 
 impl Kernel {
     /// Every kernel.
-    pub const ALL: [Kernel; 23] = [
+    pub const ALL: [Kernel; 24] = [
         Kernel::KickDrift,
         Kernel::ClosingKick,
         Kernel::BinParticles,
@@ -153,6 +155,7 @@ impl Kernel {
         Kernel::CountTouching,
         Kernel::SphereWalls,
         Kernel::SumWalls,
+        Kernel::SumEnergies,
     ];
 
     /// Its name in the source (`extern "C"`, so the PTX entry has it too).
@@ -181,6 +184,7 @@ impl Kernel {
             Kernel::CountTouching => "count_touching",
             Kernel::SphereWalls => "sphere_walls",
             Kernel::SumWalls => "sum_walls",
+            Kernel::SumEnergies => "sum_energies",
         }
     }
 
@@ -195,7 +199,7 @@ impl Kernel {
             }
             ScanChunkTotals | ScanChunkOffsets | ScanApply | ZeroWords | CopyWords => 2,
             SphereContacts | GatherForces | CountTouching => 3,
-            SphereWalls | SumWalls => 4,
+            SphereWalls | SumWalls | SumEnergies => 4,
         };
         &FILES[index]
     }

@@ -85,6 +85,8 @@ struct PairArrays {
     results: Array<Real>,
     touching: Array<u8>,
     counter: Array<u32>,
+    /// The contacts' elastic energy and dissipation of the last evaluation.
+    energies: Array<Real>,
 }
 
 /// A world of spheres on a device (see the module).
@@ -472,7 +474,17 @@ impl DeviceSpheres {
             };
             self.walls.contacts(d, &at)?;
         }
-        Ok(())
+        pairs.energies.resize(d, 2)?;
+        self.walls
+            .sum_energies(d, self.n, count, &pairs.results, &pairs.energies)
+    }
+
+    /// The elastic energy held in the contacts and the energy they dissipated over
+    /// the last step, J (the CPU backend's `StepStats::elastic_energy` and
+    /// `dissipated`, summed in its order; read back from the device).
+    pub fn energies(&mut self) -> Result<(Real, Real), DeviceError> {
+        let e = self.pairs.energies.read(self.device.as_mut())?;
+        Ok((e[0], e[1]))
     }
 
     /// Particle–wall contacts at the last force evaluation (read back from the
