@@ -276,7 +276,8 @@ extern "C" __global__ void sum_walls(unsigned n, const double* position, unsigne
 // (engine/cpu/pairs.rs `gather`, engine/cpu/walls.rs): the pairs in pair order,
 // then the wall contacts in particle order, then the springs of the wall contacts
 // that ended (in a slot of the last step, not in this one's), in the order of their
-// keys, added as one sum. Into totals[0] (energy) and totals[1] (dissipated).
+// keys, added as one sum. Into totals[0] (energy) and totals[1] (dissipated); the
+// wall contacts' count into totals[2].
 extern "C" __global__ void sum_energies(unsigned pair_count, const double* results, unsigned n,
                                         unsigned walls, const unsigned* count,
                                         const long long* keys, const double* records,
@@ -286,6 +287,7 @@ extern "C" __global__ void sum_energies(unsigned pair_count, const double* resul
         return;
     }
     double energy = 0.0, dissipated = 0.0;
+    unsigned wall_contacts = 0;
     for (unsigned e = 0; e < pair_count; ++e) {
         energy += results[RESULT_DOUBLES * e + 9];
         dissipated += results[RESULT_DOUBLES * e + 10];
@@ -297,6 +299,7 @@ extern "C" __global__ void sum_energies(unsigned pair_count, const double* resul
                 energy += record[7];
                 dissipated += record[8];
             }
+            wall_contacts += count[i];
         }
         double ended = -0.0;
         for (unsigned i = 0; i < n; ++i) {
@@ -340,4 +343,5 @@ extern "C" __global__ void sum_energies(unsigned pair_count, const double* resul
     }
     totals[0] = energy;
     totals[1] = dissipated;
+    totals[2] = wall_contacts;
 }

@@ -71,6 +71,9 @@ pub trait Device: Send + fmt::Debug {
     /// Releases `buffer`.
     fn free(&mut self, buffer: Buffer);
 
+    /// Releases every buffer.
+    fn clear(&mut self);
+
     /// The size of `buffer` in bytes.
     fn size(&self, buffer: Buffer) -> usize;
 
@@ -79,12 +82,7 @@ pub trait Device: Send + fmt::Debug {
 
     /// Copies `out.len()` bytes of `buffer` from byte `offset` into `out`, once every
     /// launch before has finished.
-    fn download(
-        &mut self,
-        buffer: Buffer,
-        offset: usize,
-        out: &mut [u8],
-    ) -> Result<(), DeviceError>;
+    fn download(&self, buffer: Buffer, offset: usize, out: &mut [u8]) -> Result<(), DeviceError>;
 
     /// Launches `kernel` on `threads` threads with `args`.
     ///
@@ -155,6 +153,10 @@ impl Device for HostDevice {
         self.buffers[buffer.0] = None;
     }
 
+    fn clear(&mut self) {
+        self.buffers.clear();
+    }
+
     fn size(&self, buffer: Buffer) -> usize {
         self.storage(buffer).1
     }
@@ -167,12 +169,7 @@ impl Device for HostDevice {
         Ok(())
     }
 
-    fn download(
-        &mut self,
-        buffer: Buffer,
-        offset: usize,
-        out: &mut [u8],
-    ) -> Result<(), DeviceError> {
+    fn download(&self, buffer: Buffer, offset: usize, out: &mut [u8]) -> Result<(), DeviceError> {
         let (words, len) = self.storage(buffer);
         check_range(offset, out.len(), *len)?;
         let bytes: &[u8] = bytemuck::cast_slice(words);
@@ -291,7 +288,7 @@ impl<T: Pod> Array<T> {
     }
 
     /// The elements.
-    pub fn read(&self, device: &mut dyn Device) -> Result<Vec<T>, DeviceError> {
+    pub fn read(&self, device: &dyn Device) -> Result<Vec<T>, DeviceError> {
         let mut out = vec![T::zeroed(); self.len];
         if self.len > 0 {
             device.download(
@@ -304,7 +301,7 @@ impl<T: Pod> Array<T> {
     }
 
     /// Element `k`.
-    pub fn get(&self, device: &mut dyn Device, k: usize) -> Result<T, DeviceError> {
+    pub fn get(&self, device: &dyn Device, k: usize) -> Result<T, DeviceError> {
         let mut out = [T::zeroed()];
         let size = size_of::<T>();
         check_range(k * size, size, self.len * size)?;

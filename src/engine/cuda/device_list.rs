@@ -44,6 +44,9 @@ pub(super) struct DeviceList {
     /// Builds so far.
     pub builds: u64,
     valid: bool,
+    /// `old_keys` were set from outside (a restored history): the next build
+    /// carries from them instead of from this list.
+    pub pending: bool,
 }
 
 /// Launches `kernel` on `threads` threads.
@@ -254,8 +257,11 @@ impl DeviceList {
             run(device, Kernel::CountPartners, n, &args)?;
         }
         let pairs = scan(device, &self.offsets, n, &mut self.chunks)?;
-        std::mem::swap(&mut self.keys, &mut self.old_keys);
-        self.old_pair_count = if self.builds == 0 { 0 } else { self.pair_count };
+        if !self.pending {
+            std::mem::swap(&mut self.keys, &mut self.old_keys);
+            self.old_pair_count = if self.builds == 0 { 0 } else { self.pair_count };
+        }
+        self.pending = false;
         self.old_keys.resize(device, 2 * self.old_pair_count)?;
         self.pair_count = pairs;
         self.pairs.resize(device, 2 * pairs)?;

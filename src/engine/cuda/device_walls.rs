@@ -340,8 +340,62 @@ impl DeviceWalls {
         }
     }
 
+    /// Takes the walls' poses, velocities, motions and the clock from `world` and
+    /// uploads what moved.
+    pub fn set_from(&mut self, device: &mut dyn Device, world: &World) -> Result<(), DeviceError> {
+        for (mine, theirs) in self.host.walls.iter_mut().zip(&world.walls) {
+            mine.pose = theirs.pose;
+            mine.velocity = theirs.velocity;
+            mine.angular_velocity = theirs.angular_velocity;
+            mine.motion = theirs.motion.clone();
+        }
+        self.host.time = world.time;
+        self.upload_placement(device)
+    }
+
+    /// Sets the patches' friction springs (sorted by key) as those of the last
+    /// evaluation, for particles of `ids` (ascending).
+    pub fn set_history(
+        &mut self,
+        device: &mut dyn Device,
+        ids: &[u64],
+        history: &[(WallKey, crate::contact::TangentialHistory)],
+    ) -> Result<(), DeviceError> {
+        if self.is_empty() {
+            return Ok(());
+        }
+        let n = ids.len();
+        let mut count = vec![0u32; n];
+        let mut keys = vec![0i64; KEY * SLOTS * n];
+        let mut springs = vec![0.0; SPRING * SLOTS * n];
+        for ((id, wall, plane), h) in history {
+            let Ok(i) = ids.binary_search(id) else {
+                continue;
+            };
+            let s = count[i] as usize;
+            if s == SLOTS {
+                return Err(DeviceError::Capacity(format!(
+                    "sphere touching walls at more than {SLOTS} places at once"
+                )));
+            }
+            let slot = SLOTS * i + s;
+            keys[KEY * slot] = *wall as i64;
+            keys[KEY * slot + 1..KEY * slot + KEY].copy_from_slice(plane);
+            springs[SPRING * slot..SPRING * slot + SPRING].copy_from_slice(&[
+                h.spring.x,
+                h.spring.y,
+                h.spring.z,
+                h.stiffness,
+            ]);
+            count[i] += 1;
+        }
+        self.new.count.write(device, &count)?;
+        self.new.keys.write(device, &keys)?;
+        self.new.springs.write(device, &springs)
+    }
+
     /// Wall contacts at the last evaluation.
-    pub fn contact_count(&self, device: &mut dyn Device) -> Result<usize, DeviceError> {
+    pub fn contact_count(&self, device: &dyn Device) -> Result<usize, DeviceError> {
         Ok(self
             .new
             .count
@@ -353,7 +407,7 @@ impl DeviceWalls {
 
     /// Copies the walls' poses, velocities, forces, torques and facet forces into
     /// `world`.
-    pub fn download(&self, device: &mut dyn Device, world: &mut World) -> Result<(), DeviceError> {
+    pub fn download(&self, device: &dyn Device, world: &mut World) -> Result<(), DeviceError> {
         let (force, torque) = (self.force.read(device)?, self.torque.read(device)?);
         let facet_force = self.facet_force.read(device)?;
         let mut first = 0;
@@ -375,7 +429,7 @@ impl DeviceWalls {
     /// The patches' friction springs by key, for particles of `ids`.
     pub fn history(
         &self,
-        device: &mut dyn Device,
+        device: &dyn Device,
         ids: &[u64],
     ) -> Result<Vec<(WallKey, [Real; 4])>, DeviceError> {
         let (count, keys) = (self.new.count.read(device)?, self.new.keys.read(device)?);

@@ -97,6 +97,10 @@ impl Device for CudaDevice {
         self.buffers[buffer.0] = None;
     }
 
+    fn clear(&mut self) {
+        self.buffers.clear();
+    }
+
     fn size(&self, buffer: Buffer) -> usize {
         self.slice(buffer).len()
     }
@@ -108,12 +112,7 @@ impl Device for CudaDevice {
         self.stream.memcpy_htod(data, &mut view).map_err(driver)
     }
 
-    fn download(
-        &mut self,
-        buffer: Buffer,
-        offset: usize,
-        out: &mut [u8],
-    ) -> Result<(), DeviceError> {
+    fn download(&self, buffer: Buffer, offset: usize, out: &mut [u8]) -> Result<(), DeviceError> {
         let slice = self.slice(buffer);
         check_range(offset, out.len(), slice.len())?;
         let view = slice.slice(offset..offset + out.len());

@@ -13,6 +13,7 @@
 //! contacts and the walls' sums; it gives the CPU backend's bits through the host
 //! executor. Polyhedra, the backend behind the seam and multi-GPU are to come.
 
+pub mod backend;
 pub mod device;
 mod device_list;
 mod device_walls;

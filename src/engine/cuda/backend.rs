@@ -1,0 +1,197 @@
+//! The CUDA backend behind the seam ([`Backend`]): a [`DeviceSpheres`] on a
+//! [`Device`], kept in step with the host world by the seam's sync contract.
+//!
+//! The device holds the particles between steps; after each step the host world
+//! gets the walls' poses, forces and facet forces, the clock, the touching flags and
+//! the step's figures (a few numbers and one byte a particle), and the particles
+//! when it asks (`sync_to_host`). A change the host makes to its world (particles
+//! added, frozen, removed, velocities set, anything else) rebuilds the stepper from
+//! the host world at the next evaluation, the contact history carried over; walls
+//! moved from outside are taken as they are.
+//!
+//! A device call that fails (a lost GPU, a sphere at more than four walls) panics:
+//! the seam's calls are infallible, and a backend that lost its state cannot go on.
+
+use std::fmt;
+
+use super::device::{Device, DeviceError};
+use super::spheres::{DeviceSpheres, SpheresError};
+use crate::Real;
+use crate::engine::backend::{Backend, ContactHistory};
+use crate::engine::params::StepParams;
+use crate::engine::stats::{Stage, StageTimes, StepStats};
+use crate::world::World;
+
+/// The CUDA backend (see the module).
+pub struct CudaBackend {
+    params: StepParams,
+    /// The device while no stepper holds it.
+    idle: Option<Box<dyn Device>>,
+    spheres: Option<DeviceSpheres>,
+    /// The history to set on the next stepper (a restore, or the one replaced).
+    history: Option<ContactHistory>,
+    stats: StepStats,
+    times: StageTimes,
+    touching: Vec<bool>,
+}
+
+impl fmt::Debug for CudaBackend {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("CudaBackend")
+            .field("params", &self.params)
+            .field("stats", &self.stats)
+            .finish_non_exhaustive()
+    }
+}
+
+fn fail(e: impl fmt::Display) -> ! {
+    panic!("the cuda backend failed: {e}")
+}
+
+impl CudaBackend {
+    /// A backend on `device` stepping `world` (checked: see [`DeviceSpheres::new`]).
+    pub fn new(
+        device: Box<dyn Device>,
+        world: &World,
+        params: StepParams,
+    ) -> Result<Self, SpheresError> {
+        let spheres = DeviceSpheres::new(device, world, &params)?;
+        Ok(CudaBackend {
+            params,
+            idle: None,
+            spheres: Some(spheres),
+            history: None,
+            stats: StepStats::default(),
+            times: StageTimes::default(),
+            touching: Vec::new(),
+        })
+    }
+
+    /// The stepper, rebuilt from `world` if the host changed it.
+    fn stepper(&mut self, world: &World) -> &mut DeviceSpheres {
+        if self.spheres.is_none() {
+            let device = self.idle.take().expect("a device");
+            let mut spheres =
+                DeviceSpheres::new(device, world, &self.params).unwrap_or_else(|e| fail(e));
+            if let Some(history) = self.history.take() {
+                spheres.set_history(&history).unwrap_or_else(|e| fail(e));
+            }
+            self.spheres = Some(spheres);
+        }
+        self.spheres.as_mut().expect("a stepper")
+    }
+
+    /// Drops the stepper (its history kept): the next evaluation rebuilds it from
+    /// the host world.
+    fn rebuild(&mut self) {
+        if let Some(spheres) = self.spheres.take() {
+            if self.history.is_none() {
+                self.history = Some(spheres.contact_history().unwrap_or_else(|e| fail(e)));
+            }
+            self.idle = Some(spheres.into_device());
+        }
+    }
+
+    /// The host world's share of an evaluation: walls, clock, figures, touching.
+    fn report_to_host(&mut self, world: &mut World) -> Result<(), DeviceError> {
+        let spheres = self.spheres.as_ref().expect("a stepper");
+        spheres.walls_to_host(world)?;
+        let integrated = world.particles.owned() - world.particles.frozen_count();
+        self.stats = StepStats {
+            integrated,
+            ..spheres.stats()?
+        };
+        self.touching = spheres.touching()?;
+        Ok(())
+    }
+}
+
+impl Backend for CudaBackend {
+    fn name(&self) -> &'static str {
+        "cuda"
+    }
+
+    fn params(&self) -> &StepParams {
+        &self.params
+    }
+
+    fn set_params(&mut self, params: StepParams) {
+        self.params = params;
+        self.rebuild();
+    }
+
+    fn initialise(&mut self, world: &mut World, dt: Real) {
+        let spheres = self.stepper(world);
+        spheres.initialise(dt).unwrap_or_else(|e| fail(e));
+        spheres.particles_to_host(world).unwrap_or_else(|e| fail(e));
+        self.report_to_host(world).unwrap_or_else(|e| fail(e));
+    }
+
+    /// One step on the device (its stages timed together as pair contacts: the
+    /// launches of a GPU return before they finish).
+    fn step(&mut self, world: &mut World, dt: Real) {
+        let start = std::time::Instant::now();
+        self.stepper(world).step(dt).unwrap_or_else(|e| fail(e));
+        self.report_to_host(world).unwrap_or_else(|e| fail(e));
+        self.times.add(Stage::PairContacts, start.elapsed());
+    }
+
+    fn stats(&self) -> &StepStats {
+        &self.stats
+    }
+
+    fn stage_times(&self) -> &StageTimes {
+        &self.times
+    }
+
+    fn touching(&self) -> &[bool] {
+        &self.touching
+    }
+
+    fn particles_added(&mut self, _world: &World, _added: std::ops::Range<usize>) {
+        self.rebuild();
+    }
+
+    fn particles_frozen(&mut self, _world: &World, _frozen: &[usize]) {
+        self.rebuild();
+    }
+
+    fn particles_removed(&mut self, _world: &World) {
+        self.rebuild();
+    }
+
+    fn velocities_set(&mut self, _world: &World) {
+        self.rebuild();
+    }
+
+    fn walls_moved(&mut self, world: &World) {
+        if let Some(spheres) = self.spheres.as_mut() {
+            spheres.walls_from_host(world).unwrap_or_else(|e| fail(e));
+        }
+    }
+
+    fn fluid_changed(&mut self, _world: &World) {}
+
+    fn world_changed(&mut self, _world: &World) {
+        self.rebuild();
+    }
+
+    fn contact_history(&self) -> ContactHistory {
+        match &self.spheres {
+            Some(spheres) => spheres.contact_history().unwrap_or_else(|e| fail(e)),
+            None => self.history.clone().unwrap_or_default(),
+        }
+    }
+
+    fn restore(&mut self, _world: &World, history: ContactHistory, stats: StepStats) {
+        self.rebuild();
+        self.history = Some(history);
+        self.stats = stats;
+    }
+
+    fn sync_to_host(&mut self, world: &mut World) {
+        if let Some(spheres) = &self.spheres {
+            spheres.particles_to_host(world).unwrap_or_else(|e| fail(e));
+        }
+    }
+}

@@ -1,0 +1,109 @@
+//! The CUDA backend behind the seam (`engine::cuda::backend`), its kernels run by the
+//! host executor, drives a whole `Simulation` as the CPU backend does: a pour of
+//! spheres from an inlet into a box (particles added every few steps, so the device
+//! stepper is rebuilt with its contact history each time), with the energy account,
+//! to the CPU backend's bits.
+#![cfg(feature = "cuda")]
+
+use std::path::Path;
+
+use talus::engine::cuda::backend::CudaBackend;
+use talus::engine::cuda::device::HostDevice;
+use talus::scene::{Scene, Simulation};
+
+const POUR: &str = r#"
+[simulation]
+dt = 2e-5
+end_time = 1.0
+gravity = [0.0, 0.0, -9.81]
+seed = 3
+[contact]
+law = "hertz_mindlin"
+[materials.glass]
+density = 2500.0
+young = 1e7
+poisson = 0.3
+restitution = 0.5
+friction = 0.5
+[shapes.bead]
+kind = "sphere"
+radius = 0.004
+[[wall]]
+name = "box"
+material = "glass"
+geometry = { kind = "box", min = [0.0, 0.0, 0.0], max = [0.05, 0.05, 0.2], open_top = true }
+[[inlet]]
+shape = "bead"
+material = "glass"
+min = [0.005, 0.005, 0.01]
+max = [0.045, 0.045, 0.06]
+rate = 20000.0
+count = 120
+velocity = [0.0, 0.0, -1.0]
+[[particles]]
+kind = "lattice"
+shape = "bead"
+material = "glass"
+min = [0.0, 0.0, 0.0]
+max = [0.05, 0.05, 0.02]
+"#;
+
+/// 2000 steps: the particles, the box's force, torque and facet forces, the step's
+/// figures and the energy account equal the CPU backend's at every hundredth step.
+#[test]
+fn a_pour_from_an_inlet_runs_as_on_the_cpu_backend_to_the_bit() {
+    let scene = Scene::parse(POUR, Path::new("pour.toml")).unwrap();
+    let mut cpu = Simulation::new(&scene);
+    let backend = CudaBackend::new(
+        Box::new(HostDevice::new(64)),
+        &scene.world,
+        scene.step_params(),
+    )
+    .unwrap();
+    let mut gpu = Simulation::with_backend(&scene, Box::new(backend));
+    assert_eq!(gpu.backend().name(), "cuda");
+    let mut most_walls = 0;
+    for step in 1..=2000 {
+        cpu.step();
+        gpu.step();
+        if step % 100 != 0 {
+            continue;
+        }
+        let (a, b) = (cpu.world(), gpu.world());
+        assert_eq!(a.particles.id, b.particles.id, "step {step}");
+        assert_eq!(a.particles.position, b.particles.position, "step {step}");
+        assert_eq!(a.particles.velocity, b.particles.velocity, "step {step}");
+        assert_eq!(a.particles.angular_momentum, b.particles.angular_momentum);
+        assert_eq!(a.particles.force, b.particles.force, "step {step}");
+        assert_eq!(a.walls[0].force, b.walls[0].force, "step {step}");
+        assert_eq!(a.walls[0].torque, b.walls[0].torque, "step {step}");
+        assert_eq!(a.walls[0].facet_force, b.walls[0].facet_force);
+        assert_eq!(a.time, b.time);
+        let (s, t) = (cpu.stats(), gpu.stats());
+        assert_eq!(
+            (s.contacts, s.pair_contacts, s.integrated),
+            (t.contacts, t.pair_contacts, t.integrated),
+            "step {step}"
+        );
+        assert_eq!(
+            (s.elastic_energy, s.dissipated),
+            (t.elastic_energy, t.dissipated)
+        );
+        assert_eq!(format!("{:?}", cpu.energy()), format!("{:?}", gpu.energy()));
+        assert_eq!(cpu.backend().touching(), gpu.backend().touching());
+        assert_eq!(
+            cpu.backend().contact_history(),
+            gpu.backend().contact_history()
+        );
+        most_walls = most_walls.max(s.contacts - s.pair_contacts);
+    }
+    let world = gpu.world();
+    let lattice = scene.world.particles.len();
+    assert_eq!(
+        world.particles.len(),
+        lattice + 120,
+        "the lattice and the inlet's"
+    );
+    assert!(most_walls > 20, "{most_walls} wall contacts at most");
+    assert!(gpu.stats().pair_contacts > 50, "{:?}", gpu.stats());
+}
