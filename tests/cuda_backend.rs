@@ -107,3 +107,49 @@ fn a_pour_from_an_inlet_runs_as_on_the_cpu_backend_to_the_bit() {
     assert!(most_walls > 20, "{most_walls} wall contacts at most");
     assert!(gpu.stats().pair_contacts > 50, "{:?}", gpu.stats());
 }
+
+/// `[simulation] backend = "cuda"` is checked when the scene is read: what the
+/// backend does not model is refused with what it is, and without a GPU driver the
+/// scene says so (on a machine with one, the scene is read and the simulation
+/// steps on GPU 0).
+#[test]
+fn a_scene_asking_for_the_cuda_backend_is_checked_when_read() {
+    let cuda = POUR.replace("seed = 3", "seed = 3\nbackend = \"cuda\"");
+    let line = cuda.lines().position(|l| l.starts_with("backend")).unwrap() + 1;
+    match Scene::parse(&cuda, Path::new("pour.toml")) {
+        Ok(scene) => {
+            assert!(talus::engine::cuda::driver::CudaDevice::is_present());
+            let mut sim = Simulation::new(&scene);
+            sim.step();
+            assert_eq!(sim.backend().name(), "cuda");
+        }
+        Err(e) => assert_eq!(
+            e.to_string(),
+            format!(
+                "pour.toml:{line}: simulation.backend: no CUDA driver (libcuda) is found: the \
+                 cuda backend needs an NVIDIA GPU and its driver"
+            )
+        ),
+    }
+    let volume = cuda.replace("law = \"hertz_mindlin\"", "law = \"volume\"");
+    let e = Scene::parse(&volume, Path::new("pour.toml")).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        format!(
+            "pour.toml:{line}: simulation.backend: the cuda backend does not yet step a law \
+             other than Hertz–Mindlin without rolling resistance"
+        )
+    );
+    let rocks = cuda.replace(
+        "kind = \"sphere\"\nradius = 0.004",
+        "kind = \"platonic\"\nsolid = \"dodecahedron\"\ncircumradius = 0.004",
+    );
+    let e = Scene::parse(&rocks, Path::new("pour.toml")).unwrap_err();
+    assert!(
+        e.to_string().ends_with("does not yet step polyhedra"),
+        "{e}"
+    );
+    // The CPU backend stays the default.
+    let scene = Scene::parse(POUR, Path::new("pour.toml")).unwrap();
+    assert_eq!(Simulation::new(&scene).backend().name(), "cpu");
+}

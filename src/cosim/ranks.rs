@@ -152,6 +152,11 @@ pub(super) fn new_simulation(
     exchange: Option<Box<dyn Ranks>>,
     state: Option<&SimState>,
 ) -> Result<Simulation, CosimError> {
+    if exchange.is_some() && scene.backend() != crate::scene::BackendSpec::Cpu {
+        return Err(CosimError::Ranks(
+            "simulation.backend: the cuda backend does not run on MPI ranks yet".into(),
+        ));
+    }
     match (exchange, state) {
         (None, None) => Ok(Simulation::new(scene)),
         (None, Some(state)) => {

@@ -15,6 +15,7 @@
 
 pub mod backend;
 pub mod broad_phase;
+pub mod choice;
 pub mod cpu;
 #[cfg(feature = "cuda")]
 pub mod cuda;

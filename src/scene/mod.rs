@@ -34,7 +34,7 @@ pub use fluid_coupling::FluidError;
 pub use plan::Plan;
 pub use rank_states::ShareState;
 pub use simulation::{Simulation, StepReport};
-pub use spec::SceneSpec;
+pub use spec::{BackendSpec, SceneSpec};
 pub use state::{FluidState, InletState, SimState, WallState};
 pub use state_bytes::{StateError, StateReader, StateWriter};
 
@@ -104,6 +104,11 @@ impl Scene {
             skin: contact.skin,
             round_law: contact.round_law(),
         }
+    }
+
+    /// What computes the steps (`[simulation] backend`).
+    pub fn backend(&self) -> BackendSpec {
+        self.spec.simulation.backend
     }
 
     /// A scene with this one's settings (time step, contact laws, materials) that
@@ -237,6 +242,13 @@ impl Scene {
                 "max_speed and kinetic_energy_per_particle must be positive, hold non-negative",
             ));
         }
+        let params = StepParams {
+            regularisation_length: spec.contact.regularisation,
+            skin: spec.contact.skin,
+            round_law: spec.contact.round_law(),
+        };
+        crate::engine::choice::check(sim.backend, &built.world, &params)
+            .map_err(|e| FieldError::new(sim_path.key("backend"), e))?;
         let drum = match &spec.drum {
             Some(d) => Some(analyses::resolve_drum(d, &built.world)?),
             None => None,

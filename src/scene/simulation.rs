@@ -6,7 +6,7 @@ use std::ops::ControlFlow;
 use super::Scene;
 use super::energy_ledger::{EnergyLedger, HeldEnergy};
 use super::ranks::{RunFigures, WholeRun, bed_height_on_ranks};
-use super::spec::{FreezeSpec, SettleSpec, UpdateInterval};
+use super::spec::{BackendSpec, FreezeSpec, SettleSpec, UpdateInterval};
 use crate::Real;
 use crate::analysis::packing::{Bed, bed_height_of};
 use crate::engine::{Backend, CpuBackend, StageTimes, StepParams, StepStats};
@@ -70,9 +70,19 @@ pub struct StepReport {
 }
 
 impl Simulation {
-    /// Starts a scene at time 0 (inlets insert what is due at 0) on the CPU backend.
+    /// Starts a scene at time 0 (inlets insert what is due at 0) on the backend it
+    /// asks for (checked when it was read).
+    ///
+    /// # Panics
+    /// When the scene's GPU cannot be opened after all (its kernels do not compile
+    /// for it, it is out of memory).
     pub fn new(scene: &Scene) -> Self {
-        Self::with_backend(scene, Box::new(CpuBackend::new(scene.step_params())))
+        let backend = match scene.backend() {
+            BackendSpec::Cpu => Box::new(CpuBackend::new(scene.step_params())),
+            other => crate::engine::choice::open(other, &scene.world, scene.step_params())
+                .unwrap_or_else(|e| panic!("simulation.backend: {e}")),
+        };
+        Self::with_backend(scene, backend)
     }
 
     /// Starts a scene at time 0 on `backend`, and evaluates the first forces.

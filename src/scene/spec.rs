@@ -280,6 +280,21 @@ pub struct SimulationSpec {
     /// End the run early once the bed has settled.
     #[serde(default)]
     pub settle: Option<SettleSpec>,
+    /// What computes the steps.
+    #[serde(default)]
+    pub backend: BackendSpec,
+}
+
+/// What computes the steps of a scene.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum BackendSpec {
+    /// The CPU backend (rayon): every scene.
+    #[default]
+    Cpu,
+    /// The CUDA backend on GPU 0 (feature `cuda`): scenes of Hertz–Mindlin spheres
+    /// without rolling resistance or a fluid, in one process.
+    Cuda,
 }
 
 fn default_gravity() -> [Real; 3] {

@@ -153,6 +153,10 @@ impl Launch {
             }
             #[cfg(feature = "mpi")]
             Launch::Rank { exchange, .. } => {
+                anyhow::ensure!(
+                    scene.backend() == talus::scene::BackendSpec::Cpu,
+                    "simulation.backend: the cuda backend does not run on MPI ranks yet"
+                );
                 let exchange = exchange
                     .take()
                     .ok_or_else(|| anyhow::anyhow!("one simulation per rank"))?;

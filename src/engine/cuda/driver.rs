@@ -39,10 +39,15 @@ fn driver(e: impl std::fmt::Debug) -> DeviceError {
 }
 
 impl CudaDevice {
+    /// Whether a CUDA driver library can be loaded.
+    pub fn is_present() -> bool {
+        // SAFETY: only tries to open the library (cudarc panics on a missing one).
+        unsafe { cudarc::driver::sys::is_culib_present() }
+    }
+
     /// Opens GPU `ordinal` and compiles every kernel for it.
     pub fn open(ordinal: usize) -> Result<Self, DeviceError> {
-        // SAFETY: only tries to open the library (cudarc panics on a missing one).
-        if !unsafe { cudarc::driver::sys::is_culib_present() } {
+        if !Self::is_present() {
             return Err(DeviceError::NoDriver);
         }
         let context = CudaContext::new(ordinal).map_err(driver)?;

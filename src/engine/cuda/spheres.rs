@@ -121,31 +121,13 @@ impl DeviceSpheres {
         world: &World,
         params: &StepParams,
     ) -> Result<Self, SpheresError> {
-        let unsupported = |what: &str| Err(SpheresError::Unsupported(what.into()));
-        if params.round_law
-            != (RoundLaw::HertzMindlin {
-                rolling: RollingModel::None,
-            })
-        {
-            return unsupported("a law other than Hertz–Mindlin without rolling resistance");
-        }
-        if world.fluid.is_some() {
-            return unsupported("a fluid");
-        }
+        Self::check(world, params)?;
         let p = &world.particles;
-        if p.ghosts() > 0 {
-            return unsupported("a rank's share of a decomposed world");
-        }
-        if !p.id.is_sorted() {
-            return unsupported("particles out of the order of their ids");
-        }
-        let mut radii = Vec::new();
-        for t in &world.body_types {
-            match t.shape.as_sphere() {
-                Some(s) => radii.push(s.radius),
-                None => return unsupported("polyhedra"),
-            }
-        }
+        let radii: Vec<Real> = world
+            .body_types
+            .iter()
+            .map(|t| t.shape.as_sphere().map_or(0.0, |s| s.radius))
+            .collect();
         let d = device.as_mut();
         let mut types = TypeArrays::default();
         let bodies = &world.body_types;
@@ -206,6 +188,37 @@ impl DeviceSpheres {
         };
         spheres.upload_particles(world)?;
         Ok(spheres)
+    }
+
+    /// Whether the stepper models `world` under `params`: `Err` names what it does
+    /// not model yet.
+    pub fn check(world: &World, params: &StepParams) -> Result<(), SpheresError> {
+        let unsupported = |what: &str| Err(SpheresError::Unsupported(what.into()));
+        if params.round_law
+            != (RoundLaw::HertzMindlin {
+                rolling: RollingModel::None,
+            })
+        {
+            return unsupported("a law other than Hertz–Mindlin without rolling resistance");
+        }
+        if world.fluid.is_some() {
+            return unsupported("a fluid");
+        }
+        let p = &world.particles;
+        if p.ghosts() > 0 {
+            return unsupported("a rank's share of a decomposed world");
+        }
+        if !p.id.is_sorted() {
+            return unsupported("particles out of the order of their ids");
+        }
+        if world
+            .body_types
+            .iter()
+            .any(|t| t.shape.as_sphere().is_none())
+        {
+            return unsupported("polyhedra");
+        }
+        Ok(())
     }
 
     /// Copies the particles' state to the device.
