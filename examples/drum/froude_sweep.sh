@@ -4,14 +4,14 @@
 # halved (the plates' material at μ = 0, so particle–plate pairs take 0.35), then
 # draws the regimes talus names against Mellmann's bands (regime_map.png).
 #   examples/drum/froude_sweep.sh [FROUDE:END_TIME ...]
-# Default: 1e-3 (10 s simulated) … 1.5 (5 s); averages after 1 s. Scenes and outputs go to
+# Default: 1e-4 (15 s simulated) … 1.5 (5 s); averages after 1 s. Scenes and outputs go to
 # examples/drum/froude/ (not kept in git). RUNS (default 2) runs at once, one thread
-# each; about 45 minutes on two cores.
+# each; about an hour on two cores.
 set -euo pipefail
 here="$(cd "$(dirname "$0")" && pwd)"
 root="$(cd "$here/../.." && pwd)"
 cases=("$@")
-[ ${#cases[@]} -gt 0 ] || cases=(0.001:10 0.01:6 0.03:5 0.1:3 0.2:3 0.6:3 1.0:5 1.5:5)
+[ ${#cases[@]} -gt 0 ] || cases=(0.0001:15 0.001:10 0.01:6 0.03:5 0.1:3 0.2:3 0.6:3 1.0:5 1.5:5)
 (cd "$root" && cargo build --release --quiet)
 "$root/scripts/python-env.sh" "$here/requirements.txt"
 out="$here/froude"
