@@ -25,7 +25,7 @@
 //! less than half the shell's speed slips; a tenth of the slice in flight
 //! cataracts; a bed at rest in the drum in three samples of ten slumps; a curved
 //! surface cascades; a straight one rolls. The thresholds were set against the
-//! quasi-2D example's sweep over Froude numbers 1e-3 … 1.5 and Mellmann's (2001)
+//! quasi-2D example's sweep over Froude numbers 1e-4 … 1.5 and Mellmann's (2001)
 //! bands (`examples/drum/README.md`).
 
 use serde::{Deserialize, Serialize};
