@@ -152,7 +152,7 @@ pub(super) fn new_simulation(
     exchange: Option<Box<dyn Ranks>>,
     state: Option<&SimState>,
 ) -> Result<Simulation, CosimError> {
-    if exchange.is_some() && scene.backend() != crate::scene::BackendSpec::Cpu {
+    if exchange.is_some() && scene.backend() != crate::engine::choice::BackendKind::Cpu {
         return Err(CosimError::Ranks(
             "simulation.backend: the cuda backend does not run on MPI ranks yet".into(),
         ));

@@ -1,19 +1,32 @@
 //! The backend a scene asks for (`[simulation] backend`), checked when the scene is
 //! read and opened when a simulation starts.
 
+use serde::{Deserialize, Serialize};
+
 use super::backend::Backend;
 use super::cpu::CpuBackend;
 use super::params::StepParams;
-use crate::scene::spec::BackendSpec;
 use crate::world::World;
+
+/// What computes the steps of a scene (`[simulation] backend`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum BackendKind {
+    /// The CPU backend (rayon): every scene.
+    #[default]
+    Cpu,
+    /// The CUDA backend on GPU 0 (feature `cuda`): scenes of Hertz–Mindlin spheres
+    /// without rolling resistance or a fluid, in one process.
+    Cuda,
+}
 
 /// Whether `world` can be stepped by `backend` here: `Err` says why not (the
 /// feature not built, a scene the backend does not model, no GPU driver).
-pub fn check(backend: BackendSpec, world: &World, params: &StepParams) -> Result<(), String> {
+pub fn check(backend: BackendKind, world: &World, params: &StepParams) -> Result<(), String> {
     match backend {
-        BackendSpec::Cpu => Ok(()),
+        BackendKind::Cpu => Ok(()),
         #[cfg(feature = "cuda")]
-        BackendSpec::Cuda => {
+        BackendKind::Cuda => {
             super::cuda::spheres::DeviceSpheres::check(world, params).map_err(|e| e.to_string())?;
             if super::cuda::driver::CudaDevice::is_present() {
                 Ok(())
@@ -22,7 +35,7 @@ pub fn check(backend: BackendSpec, world: &World, params: &StepParams) -> Result
             }
         }
         #[cfg(not(feature = "cuda"))]
-        BackendSpec::Cuda => {
+        BackendKind::Cuda => {
             let _ = (world, params);
             Err(
                 "this talus was built without the cuda feature (cargo build --features cuda)"
@@ -35,21 +48,21 @@ pub fn check(backend: BackendSpec, world: &World, params: &StepParams) -> Result
 /// The backend `backend` for `world` (checked by [`check`]); `Err` when the device
 /// cannot be opened.
 pub fn open(
-    backend: BackendSpec,
+    backend: BackendKind,
     world: &World,
     params: StepParams,
 ) -> Result<Box<dyn Backend>, String> {
     check(backend, world, &params)?;
     match backend {
-        BackendSpec::Cpu => Ok(Box::new(CpuBackend::new(params))),
+        BackendKind::Cpu => Ok(Box::new(CpuBackend::new(params))),
         #[cfg(feature = "cuda")]
-        BackendSpec::Cuda => {
+        BackendKind::Cuda => {
             let device = super::cuda::driver::CudaDevice::open(0).map_err(|e| e.to_string())?;
             let backend = super::cuda::backend::CudaBackend::new(Box::new(device), world, params)
                 .map_err(|e| e.to_string())?;
             Ok(Box::new(backend))
         }
         #[cfg(not(feature = "cuda"))]
-        BackendSpec::Cuda => unreachable!("refused by check"),
+        BackendKind::Cuda => unreachable!("refused by check"),
     }
 }

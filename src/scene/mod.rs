@@ -34,7 +34,7 @@ pub use fluid_coupling::FluidError;
 pub use plan::Plan;
 pub use rank_states::ShareState;
 pub use simulation::{Simulation, StepReport};
-pub use spec::{BackendSpec, SceneSpec};
+pub use spec::SceneSpec;
 pub use state::{FluidState, InletState, SimState, WallState};
 pub use state_bytes::{StateError, StateReader, StateWriter};
 
@@ -107,7 +107,7 @@ impl Scene {
     }
 
     /// What computes the steps (`[simulation] backend`).
-    pub fn backend(&self) -> BackendSpec {
+    pub fn backend(&self) -> crate::engine::choice::BackendKind {
         self.spec.simulation.backend
     }
 

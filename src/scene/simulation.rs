@@ -6,9 +6,10 @@ use std::ops::ControlFlow;
 use super::Scene;
 use super::energy_ledger::{EnergyLedger, HeldEnergy};
 use super::ranks::{RunFigures, WholeRun, bed_height_on_ranks};
-use super::spec::{BackendSpec, FreezeSpec, SettleSpec, UpdateInterval};
+use super::spec::{FreezeSpec, SettleSpec, UpdateInterval};
 use crate::Real;
 use crate::analysis::packing::{Bed, bed_height_of};
+use crate::engine::choice::BackendKind;
 use crate::engine::{Backend, CpuBackend, StageTimes, StepParams, StepStats};
 use crate::world::{Inlet, MassMoments, Wall, World};
 
@@ -78,7 +79,7 @@ impl Simulation {
     /// for it, it is out of memory).
     pub fn new(scene: &Scene) -> Self {
         let backend = match scene.backend() {
-            BackendSpec::Cpu => Box::new(CpuBackend::new(scene.step_params())),
+            BackendKind::Cpu => Box::new(CpuBackend::new(scene.step_params())),
             other => crate::engine::choice::open(other, &scene.world, scene.step_params())
                 .unwrap_or_else(|e| panic!("simulation.backend: {e}")),
         };

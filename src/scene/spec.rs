@@ -12,6 +12,7 @@ use serde::{Deserialize, Serialize};
 use crate::Real;
 use crate::contact::RollingModel;
 use crate::engine::RoundLaw;
+use crate::engine::choice::BackendKind;
 use crate::geometry::ShapeSpec;
 use crate::world::{DriveInput, MotionKey};
 
@@ -282,19 +283,7 @@ pub struct SimulationSpec {
     pub settle: Option<SettleSpec>,
     /// What computes the steps.
     #[serde(default)]
-    pub backend: BackendSpec,
-}
-
-/// What computes the steps of a scene.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, Serialize)]
-#[serde(rename_all = "lowercase")]
-pub enum BackendSpec {
-    /// The CPU backend (rayon): every scene.
-    #[default]
-    Cpu,
-    /// The CUDA backend on GPU 0 (feature `cuda`): scenes of Hertz–Mindlin spheres
-    /// without rolling resistance or a fluid, in one process.
-    Cuda,
+    pub backend: BackendKind,
 }
 
 fn default_gravity() -> [Real; 3] {

@@ -154,7 +154,7 @@ impl Launch {
             #[cfg(feature = "mpi")]
             Launch::Rank { exchange, .. } => {
                 anyhow::ensure!(
-                    scene.backend() == talus::scene::BackendSpec::Cpu,
+                    scene.backend() == talus::engine::choice::BackendKind::Cpu,
                     "simulation.backend: the cuda backend does not run on MPI ranks yet"
                 );
                 let exchange = exchange

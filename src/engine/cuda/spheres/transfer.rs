@@ -1,0 +1,198 @@
+//! What crosses between a [`DeviceSpheres`] and the host: the particles, the walls
+//! and the clock, the figures of the last evaluation, the contact history both ways,
+//! and the device memory it holds.
+
+use nalgebra::{Point3, Quaternion, UnitQuaternion, Vector3};
+
+use super::{DeviceSpheres, HISTORY};
+use crate::Real;
+use crate::contact::TangentialHistory;
+use crate::engine::backend::ContactHistory;
+use crate::engine::cuda::device::{Array, Device, DeviceError};
+use crate::world::World;
+
+impl DeviceSpheres {
+    /// Bytes of device memory the stepper holds: particles, body types, the list,
+    /// the pairs' history and results, the walls (buffers have room to grow by
+    /// half).
+    pub fn device_bytes(&self) -> usize {
+        let d = self.device.as_ref();
+        let (p, t, q) = (&self.particles, &self.types, &self.pairs);
+        let doubles = [
+            &p.position,
+            &p.velocity,
+            &p.orientation,
+            &p.angular_momentum,
+            &p.force,
+            &p.torque,
+            &t.mass,
+            &t.inertia,
+            &t.radius,
+            &t.inverse_mass,
+            &t.inverse_inertia,
+            &t.material_pairs,
+            &q.history,
+            &q.old_history,
+            &q.results,
+        ];
+        let bytes = [&p.frozen, &p.touching, &q.touching];
+        doubles.iter().map(|a| a.bytes(d)).sum::<usize>()
+            + bytes.iter().map(|a| a.bytes(d)).sum::<usize>()
+            + [&p.body_type, &t.material, &q.counter]
+                .iter()
+                .map(|a| a.bytes(d))
+                .sum::<usize>()
+            + p.id.bytes(d)
+            + self.list.bytes(d)
+            + self.walls.bytes(d)
+    }
+
+    /// The elastic energy held in the contacts and the energy they dissipated over
+    /// the last step, J (the CPU backend's `StepStats::elastic_energy` and
+    /// `dissipated`, summed in its order; read back from the device).
+    pub fn energies(&self) -> Result<(Real, Real), DeviceError> {
+        let e = self.pairs.energies.read(self.device.as_ref())?;
+        Ok((e[0], e[1]))
+    }
+
+    /// The figures of the last force evaluation: contacts (pairs and walls), the
+    /// pairs', candidate pairs, elastic energy and dissipation, list builds (one
+    /// read of three numbers from the device).
+    pub fn stats(&self) -> Result<crate::engine::StepStats, DeviceError> {
+        let e = self.pairs.energies.read(self.device.as_ref())?;
+        Ok(crate::engine::StepStats {
+            contacts: self.contacts + e[2] as usize,
+            pair_contacts: self.contacts,
+            candidate_pairs: self.list.pair_count,
+            integrated: 0,
+            elastic_energy: e[0],
+            dissipated: e[1],
+            fluid_work: 0.0,
+            list_builds: self.list.builds,
+        })
+    }
+
+    /// Gives the device back, its buffers released.
+    pub fn into_device(mut self) -> Box<dyn Device> {
+        self.device.clear();
+        self.device
+    }
+
+    /// Sets the tangential history (of a restored state, or of the stepper this one
+    /// replaces): the pairs' is carried into the list at its next build (which
+    /// this forces), the walls' patches into their slots.
+    pub fn set_history(&mut self, history: &ContactHistory) -> Result<(), DeviceError> {
+        let d = self.device.as_mut();
+        let keys: Vec<u64> = history.pairs.iter().flat_map(|(k, _)| [k.0, k.1]).collect();
+        let springs: Vec<Real> = history
+            .pairs
+            .iter()
+            .flat_map(|(_, h)| [h.spring.x, h.spring.y, h.spring.z, h.stiffness])
+            .collect();
+        self.list.old_keys.write(d, &keys)?;
+        self.list.old_pair_count = history.pairs.len();
+        self.list.pending = true;
+        self.list.invalidate();
+        self.pairs.old_history.write(d, &springs)?;
+        let ids = self.particles.id.read(d)?;
+        self.walls.set_history(d, &ids, &history.walls)
+    }
+
+    /// Takes the walls' poses, velocities and motions from `world` (moved by the
+    /// host or set from outside) and uploads what moved.
+    pub fn walls_from_host(&mut self, world: &World) -> Result<(), DeviceError> {
+        self.walls.set_from(self.device.as_mut(), world)
+    }
+
+    /// Copies the walls' poses, velocities, forces, torques and facet forces and
+    /// the clock into `world`.
+    pub fn walls_to_host(&self, world: &mut World) -> Result<(), DeviceError> {
+        world.time = self.time;
+        self.walls.download(self.device.as_ref(), world)
+    }
+
+    /// Particle–wall contacts at the last force evaluation (read back from the
+    /// device).
+    pub fn wall_contacts(&mut self) -> Result<usize, DeviceError> {
+        self.walls.contact_count(self.device.as_mut())
+    }
+
+    /// Copies the particles' state and forces, the walls and the clock into
+    /// `world` (the world the stepper was made from, or a copy of it).
+    pub fn download(&self, world: &mut World) -> Result<(), DeviceError> {
+        self.particles_to_host(world)?;
+        self.walls_to_host(world)
+    }
+
+    /// Copies the particles' state and forces into `world`.
+    pub fn particles_to_host(&self, world: &mut World) -> Result<(), DeviceError> {
+        let (d, a) = (self.device.as_ref(), &self.particles);
+        let p = &mut world.particles;
+        let vectors = |x: &Array<Real>| -> Result<Vec<Vector3<Real>>, DeviceError> {
+            Ok(x.read(d)?
+                .chunks_exact(3)
+                .map(Vector3::from_column_slice)
+                .collect())
+        };
+        p.position = vectors(&a.position)?
+            .into_iter()
+            .map(Point3::from)
+            .collect();
+        p.velocity = vectors(&a.velocity)?;
+        p.angular_momentum = vectors(&a.angular_momentum)?;
+        p.force = vectors(&a.force)?;
+        p.torque = vectors(&a.torque)?;
+        p.orientation = a
+            .orientation
+            .read(d)?
+            .chunks_exact(4)
+            .map(|q| UnitQuaternion::new_unchecked(Quaternion::new(q[3], q[0], q[1], q[2])))
+            .collect();
+        Ok(())
+    }
+
+    /// Whether each particle touched another at the last force evaluation (frozen
+    /// ones count as touching).
+    pub fn touching(&self) -> Result<Vec<bool>, DeviceError> {
+        let flags = self.particles.touching.read(self.device.as_ref())?;
+        Ok(flags.into_iter().map(|t| t != 0).collect())
+    }
+
+    /// The pairs' tangential history, sorted by the particles' ids (pairs apart,
+    /// whose history is empty, left out): the CPU backend's
+    /// [`crate::engine::Backend::contact_history`].
+    pub fn contact_history(&self) -> Result<ContactHistory, DeviceError> {
+        let d = self.device.as_ref();
+        let keys = self.list.keys.read(d)?;
+        let history = self.pairs.history.read(d)?;
+        let pairs = keys
+            .chunks_exact(2)
+            .zip(history.chunks_exact(HISTORY))
+            .map(|(k, h)| {
+                let kept = TangentialHistory {
+                    spring: Vector3::new(h[0], h[1], h[2]),
+                    stiffness: h[3],
+                    ..Default::default()
+                };
+                ((k[0], k[1]), kept)
+            })
+            .filter(|(_, h)| !h.is_empty())
+            .collect();
+        let ids = self.particles.id.read(d)?;
+        let walls = self
+            .walls
+            .history(d, &ids)?
+            .into_iter()
+            .map(|(key, h)| {
+                let kept = TangentialHistory {
+                    spring: Vector3::new(h[0], h[1], h[2]),
+                    stiffness: h[3],
+                    ..Default::default()
+                };
+                (key, kept)
+            })
+            .filter(|(_, h)| !h.is_empty())
+            .collect();
+        Ok(ContactHistory { pairs, walls })
+    }
+}
