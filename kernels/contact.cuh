@@ -4,6 +4,8 @@
 // backend's operations in its order. Compiled after vec.cuh.
 
 #define HISTORY_DOUBLES 4u
+// A record of the energy sums (sums.cu): elastic energy, dissipated, wall contacts.
+#define ENERGY_RECORD 3u
 #define RESULT_DOUBLES 11u
 #define MATERIAL_DOUBLES 5u
 

@@ -18,6 +18,7 @@ thread_local dim3 threadIdx, blockIdx, blockDim, gridDim;
 #include "scan.cu"
 #include "spheres.cu"
 #include "walls.cu"
+#include "sums.cu"
 
 // Sets the built-ins of the calling thread before it runs one kernel thread.
 extern "C" void talus_host_at(unsigned block, unsigned thread, unsigned block_dim,
@@ -59,7 +60,8 @@ static const Entry kernels[] = {
     KERNEL(copy_doubles),      KERNEL(scan_chunk_totals), KERNEL(scan_chunk_offsets),
     KERNEL(scan_apply),        KERNEL(zero_words),       KERNEL(copy_words),
     KERNEL(sphere_contacts),   KERNEL(gather_forces),    KERNEL(count_touching),
-    KERNEL(sphere_walls),      KERNEL(sum_walls),        KERNEL(sum_energies),
+    KERNEL(sphere_walls),      KERNEL(wall_sum_rows),    KERNEL(wall_energy_terms),
+    KERNEL(pair_energy_partials), KERNEL(sum_records),
 };
 
 // The trampoline of the kernel named `name`, or null.

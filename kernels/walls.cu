@@ -2,9 +2,10 @@
 // engine/cpu/patch.rs, geometry/sphere.rs): one thread per particle, every wall's
 // facets tested (no facet list yet: O(particles × facets)), the facets of one
 // plane merged into one contact at the deepest, the contacts added to the
-// particle's force and torque in wall and patch order after the pairs' gather;
-// then one thread sums the walls' forces, torques and facet forces in particle
-// order. The CPU backend's operations in its order, so the same bits.
+// particle's force and torque in wall and patch order after the pairs' gather:
+// the CPU backend's operations in its order, so the same bits. Then the walls'
+// forces, torques and facet forces, and the contacts' energies, as rows and
+// records that sums.cu folds in a fixed order (the CPU's sums to round-off).
 //
 // Layouts: facets of all walls one after the other, wall w's from
 // wall_facets[w] to wall_facets[w + 1]: placed corners (9 doubles) and unit
@@ -233,115 +234,103 @@ extern "C" __global__ void sphere_walls(
     store3(torque, i, t);
 }
 
-// One thread: every wall's force, torque and facet forces, summed over the
-// particles' wall contacts in particle order.
-extern "C" __global__ void sum_walls(unsigned n, const double* position, unsigned walls,
-                                     const unsigned* wall_facets, const double* wall_motion,
-                                     const unsigned* count, const long long* keys,
-                                     const double* records, const unsigned* record_facet,
-                                     double* wall_force, double* wall_torque,
-                                     double* facet_force) {
-    if (blockIdx.x * blockDim.x + threadIdx.x != 0) {
+// The walls' sums, first pass (sums.cu folds the rest): thread t of `groups` adds
+// the wall contacts of particles t, t + groups, … in that order into row t of
+// `rows`, what the particles push on the walls: per wall its force and torque
+// about its reference point (6 doubles), then per facet its force (3 doubles).
+extern "C" __global__ void wall_sum_rows(unsigned n, const double* position, unsigned walls,
+                                         const unsigned* wall_facets, const double* wall_motion,
+                                         const unsigned* count, const long long* keys,
+                                         const double* records, const unsigned* record_facet,
+                                         unsigned groups, double* rows) {
+    unsigned t = blockIdx.x * blockDim.x + threadIdx.x;
+    if (t >= groups) {
         return;
     }
-    for (unsigned w = 0; w < walls; ++w) {
-        store3(wall_force, w, Vec3{0.0, 0.0, 0.0});
-        store3(wall_torque, w, Vec3{0.0, 0.0, 0.0});
+    unsigned width = 6 * walls + 3 * wall_facets[walls];
+    double* row = rows + (size_t)width * t;
+    for (unsigned k = 0; k < width; ++k) {
+        row[k] = 0.0;
     }
-    for (unsigned k = 0; k < wall_facets[walls]; ++k) {
-        store3(facet_force, k, Vec3{0.0, 0.0, 0.0});
-    }
-    for (unsigned i = 0; i < n; ++i) {
+    for (unsigned i = t; i < n; i += groups) {
         Vec3 x = load3(position, i);
         for (unsigned s = 0; s < count[i]; ++s) {
             unsigned slot = WALL_SLOTS * i + s;
             unsigned w = (unsigned)keys[KEY_WORDS * slot];
             const double* record = records + RECORD_DOUBLES * slot;
-            Vec3 f = load3(record, 0), t = load3(record, 1);
+            Vec3 f = load3(record, 0), torque = load3(record, 1);
             Vec3 reference = load3(wall_motion + 9 * w, 2);
-            store3(wall_force, w, sub(load3(wall_force, w), f));
-            Vec3 reaction = scale(add(t, cross(sub(x, reference), f)), -1.0);
-            store3(wall_torque, w, add(load3(wall_torque, w), reaction));
+            store3(row, 2 * w, sub(load3(row, 2 * w), f));
+            Vec3 reaction = scale(add(torque, cross(sub(x, reference), f)), -1.0);
+            store3(row, 2 * w + 1, add(load3(row, 2 * w + 1), reaction));
             double share = record[6];
             if (share > 0.0) {
-                unsigned facet = record_facet[slot];
-                store3(facet_force, facet, sub(load3(facet_force, facet), scale(f, share / share)));
+                unsigned facet = 2 * walls + record_facet[slot];
+                store3(row, facet, sub(load3(row, facet), scale(f, share / share)));
             }
         }
     }
 }
 
-// One thread: the elastic energy held in the contacts and the energy they
-// dissipated over the step, summed as the CPU backend sums them
-// (engine/cpu/pairs.rs `gather`, engine/cpu/walls.rs): the pairs in pair order,
-// then the wall contacts in particle order, then the springs of the wall contacts
-// that ended (in a slot of the last step, not in this one's), in the order of their
-// keys, added as one sum. Into totals[0] (energy) and totals[1] (dissipated); the
-// wall contacts' count into totals[2].
-extern "C" __global__ void sum_energies(unsigned pair_count, const double* results, unsigned n,
-                                        unsigned walls, const unsigned* count,
-                                        const long long* keys, const double* records,
-                                        const unsigned* old_count, const long long* old_keys,
-                                        const double* old_springs, double* totals) {
-    if (blockIdx.x * blockDim.x + threadIdx.x != 0) {
+// One thread a particle: the elastic energy held in its wall contacts, the energy
+// they dissipated over the step with the springs of its wall contacts that ended
+// (in a slot of the last step, not in this one's; in the order of their keys), and
+// their count, as record `first + i` of `terms` (ENERGY_RECORD doubles, summed by
+// sums.cu). The CPU backend's terms (engine/cpu/walls.rs), the ended springs in its
+// order.
+extern "C" __global__ void wall_energy_terms(unsigned n, const unsigned* count,
+                                             const long long* keys, const double* records,
+                                             const unsigned* old_count,
+                                             const long long* old_keys,
+                                             const double* old_springs, unsigned first,
+                                             double* terms) {
+    unsigned i = blockIdx.x * blockDim.x + threadIdx.x;
+    if (i >= n) {
         return;
     }
     double energy = 0.0, dissipated = 0.0;
-    unsigned wall_contacts = 0;
-    for (unsigned e = 0; e < pair_count; ++e) {
-        energy += results[RESULT_DOUBLES * e + 9];
-        dissipated += results[RESULT_DOUBLES * e + 10];
+    for (unsigned s = 0; s < count[i]; ++s) {
+        const double* record = records + RECORD_DOUBLES * (WALL_SLOTS * i + s);
+        energy += record[7];
+        dissipated += record[8];
     }
-    if (walls > 0) {
-        for (unsigned i = 0; i < n; ++i) {
-            for (unsigned s = 0; s < count[i]; ++s) {
-                const double* record = records + RECORD_DOUBLES * (WALL_SLOTS * i + s);
-                energy += record[7];
-                dissipated += record[8];
+    // The ended slots, in the order of their keys.
+    unsigned order[WALL_SLOTS];
+    unsigned m = 0;
+    for (unsigned s = 0; s < old_count[i]; ++s) {
+        const long long* o = old_keys + KEY_WORDS * (WALL_SLOTS * i + s);
+        bool kept = false;
+        for (unsigned t = 0; t < count[i]; ++t) {
+            const long long* k = keys + KEY_WORDS * (WALL_SLOTS * i + t);
+            bool same = true;
+            for (unsigned c = 0; c < KEY_WORDS; ++c) {
+                same = same && o[c] == k[c];
             }
-            wall_contacts += count[i];
+            kept = kept || same;
         }
-        double ended = -0.0;
-        for (unsigned i = 0; i < n; ++i) {
-            // The ended slots of particle i, in the order of their keys.
-            unsigned order[WALL_SLOTS];
-            unsigned m = 0;
-            for (unsigned s = 0; s < old_count[i]; ++s) {
-                const long long* o = old_keys + KEY_WORDS * (WALL_SLOTS * i + s);
-                bool kept = false;
-                for (unsigned t = 0; t < count[i]; ++t) {
-                    const long long* k = keys + KEY_WORDS * (WALL_SLOTS * i + t);
-                    bool same = true;
-                    for (unsigned c = 0; c < KEY_WORDS; ++c) {
-                        same = same && o[c] == k[c];
-                    }
-                    kept = kept || same;
-                }
-                if (kept) {
-                    continue;
-                }
-                unsigned at = m++;
-                for (; at > 0; --at) {
-                    const long long* a = old_keys + KEY_WORDS * (WALL_SLOTS * i + order[at - 1]);
-                    unsigned c = 0;
-                    while (c < KEY_WORDS && a[c] == o[c]) {
-                        ++c;
-                    }
-                    if (c == KEY_WORDS || a[c] < o[c]) {
-                        break;
-                    }
-                    order[at] = order[at - 1];
-                }
-                order[at] = s;
-            }
-            for (unsigned k = 0; k < m; ++k) {
-                const double* h = old_springs + HISTORY_DOUBLES * (WALL_SLOTS * i + order[k]);
-                ended += spring_energy(Spring{load3(h, 0), h[3]});
-            }
+        if (kept) {
+            continue;
         }
-        dissipated += ended;
+        unsigned at = m++;
+        for (; at > 0; --at) {
+            const long long* a = old_keys + KEY_WORDS * (WALL_SLOTS * i + order[at - 1]);
+            unsigned c = 0;
+            while (c < KEY_WORDS && a[c] == o[c]) {
+                ++c;
+            }
+            if (c == KEY_WORDS || a[c] < o[c]) {
+                break;
+            }
+            order[at] = order[at - 1];
+        }
+        order[at] = s;
     }
-    totals[0] = energy;
-    totals[1] = dissipated;
-    totals[2] = wall_contacts;
+    for (unsigned k = 0; k < m; ++k) {
+        const double* h = old_springs + HISTORY_DOUBLES * (WALL_SLOTS * i + order[k]);
+        dissipated += spring_energy(Spring{load3(h, 0), h[3]});
+    }
+    double* record = terms + ENERGY_RECORD * (first + i);
+    record[0] = energy;
+    record[1] = dissipated;
+    record[2] = (double)count[i];
 }

@@ -24,6 +24,7 @@ use std::time::Instant;
 use anyhow::{Result, anyhow, bail};
 use rand::{Rng, SeedableRng};
 use talus::Real;
+use talus::engine::choice::{self, BackendKind};
 use talus::scene::{Scene, Simulation};
 
 pub fn machine() -> String {
@@ -451,6 +452,38 @@ fn measure(scene: &Scene, threads: usize, warmup: usize, steps: usize) -> Result
     }))
 }
 
+/// The scene's backend stepped alone, without the simulation's work between steps
+/// (particles copied to the host, their finiteness, inlets, the bed, the energy
+/// account): what the backend itself computes, and by difference what that work
+/// costs.
+fn measure_backend(scene: &Scene, warmup: usize, steps: usize) -> Result<Measured> {
+    let mut world = scene.world.clone();
+    let dt = scene.dt;
+    let mut backend = choice::open(scene.spec.simulation.backend, &world, scene.step_params())
+        .map_err(|e| anyhow!("{e}"))?;
+    backend.initialise(&mut world, dt);
+    for _ in 0..warmup {
+        backend.step(&mut world, dt);
+    }
+    let before = *backend.stage_times();
+    let mut contacts = 0usize;
+    let t = Instant::now();
+    for _ in 0..steps {
+        backend.step(&mut world, dt);
+        contacts += backend.stats().contacts;
+    }
+    let s = t.elapsed().as_secs_f64();
+    let steps = steps.max(1);
+    Ok(Measured {
+        stages: backend.stage_times().since(&before).shares(),
+        particles: world.particles.len(),
+        pairs: backend.stats().candidate_pairs,
+        contacts: contacts as f64 / steps as f64,
+        particle_steps: (world.particles.len() * steps) as f64 / s,
+        contact_rate: contacts as f64 / s,
+    })
+}
+
 /// One row of the table and the stage shares below it.
 fn print_row(name: &str, threads: usize, m: &Measured, dt: f64, error: &str) {
     println!(
@@ -530,6 +563,24 @@ pub struct BenchOptions {
     pub scenes: Vec<char>,
     /// The thread counts to measure on.
     pub threads: Vec<usize>,
+    /// The backend that steps the scenes.
+    pub backend: BackendKind,
+}
+
+/// `text` (a scene) stepped by `backend`, its spheres under Hertz–Mindlin where the
+/// backend models no other law (the CUDA backend).
+fn on_backend(text: &str, backend: BackendKind) -> String {
+    match backend {
+        BackendKind::Cpu => text.to_string(),
+        BackendKind::Cuda => {
+            let text = text.replacen("[simulation]\n", "[simulation]\nbackend = \"cuda\"\n", 1);
+            if text.contains("law = ") {
+                text
+            } else {
+                text.replacen("[contact]\n", "[contact]\nlaw = \"hertz_mindlin\"\n", 1)
+            }
+        }
+    }
 }
 
 /// `talus bench`.
@@ -540,39 +591,50 @@ pub fn bench(options: BenchOptions) -> Result<()> {
     if options.threads.contains(&0) {
         bail!("--threads: a thread count is at least 1");
     }
+    let spheres_only = options.backend == BackendKind::Cuda;
+    if let Some(bad) = options
+        .scenes
+        .iter()
+        .find(|c| spheres_only && "ad".contains(**c))
+    {
+        bail!("--scene {bad}: the cuda backend steps spheres only (scenes b and c)");
+    }
     let dir = std::env::temp_dir().join(format!("talus-bench-{}", std::process::id()));
     std::fs::create_dir_all(&dir)?;
     let bed_count = (10_000.0 * options.scale).round() as usize;
     let pour_count = ((5000.0 * options.scale).round() as usize).max(2);
     let sphere_bed_side = ((5000.0 * options.scale).cbrt().round() as usize).max(2);
     let sphere = "kind = \"sphere\"\nradius = 0.005";
-    let wanted = |letter: char| options.scenes.is_empty() || options.scenes.contains(&letter);
-    // (letter, name, scene, the drop whose restitution error is printed, whether the
-    // whole run is timed).
+    let wanted = |letter: char| {
+        let all = options.scenes.is_empty() && !(spheres_only && "ad".contains(letter));
+        all || options.scenes.contains(&letter)
+    };
+    // (letter, name, the drop whose restitution error is printed, whether the whole
+    // run is timed); each scene is written when measured.
     let cases = [
         (
             'a',
             "(a) settled bed of dodecahedra",
-            settled_bed(&dir, bed_count)?,
             Some((DODECAHEDRON, 0.2)),
             false,
         ),
-        (
-            'b',
-            "(b) pour of spheres to rest",
-            pour(&dir, pour_count)?,
-            None,
-            true,
-        ),
-        (
-            'c',
-            "(c) dense bed of spheres",
-            dense_lattice(sphere_bed_side, sphere, 1.98),
-            Some((sphere, 0.01)),
-            false,
-        ),
+        ('b', "(b) pour of spheres to rest", None, true),
+        ('c', "(c) dense bed of spheres", Some((sphere, 0.01)), false),
     ];
+    let text = |letter: char| -> Result<String> {
+        match letter {
+            'a' => settled_bed(&dir, bed_count),
+            'b' => pour(&dir, pour_count),
+            _ => Ok(dense_lattice(sphere_bed_side, sphere, 1.98)),
+        }
+    };
     println!("machine: {}", machine());
+    if spheres_only {
+        println!(
+            "backend: cuda on GPU 0 (scene (c) under Hertz–Mindlin; threads: the host's, \
+             which waits for the device)"
+        );
+    }
     println!(
         "{:<38} {:>7} {:>9} {:>10} {:>9} {:>8} {:>16} {:>14} {:>10}",
         "scene",
@@ -585,10 +647,11 @@ pub fn bench(options: BenchOptions) -> Result<()> {
         "contacts/s",
         "e error"
     );
-    for (_, name, text, drop, whole) in cases.into_iter().filter(|c| wanted(c.0)) {
+    for (letter, name, drop, whole) in cases.into_iter().filter(|c| wanted(c.0)) {
         let path = dir.join("scene.toml");
-        std::fs::write(&path, &text)?;
+        std::fs::write(&path, on_backend(&text(letter)?, options.backend))?;
         let scene = Scene::load(&path)?;
+        let drop = drop.filter(|_| !spheres_only);
         let error = drop.map_or("-".to_string(), |(shape, reg)| {
             format!("{:.2}%", 100.0 * restitution_error(shape, scene.dt, reg))
         });
@@ -603,6 +666,10 @@ pub fn bench(options: BenchOptions) -> Result<()> {
         for &threads in &options.threads {
             let m = measure(&scene, threads, warmup, steps)?;
             print_row(name, threads, &m, scene.dt, &error);
+        }
+        if spheres_only {
+            let m = measure_backend(&scene, warmup, steps)?;
+            print_row(&format!("{name}, backend alone"), 1, &m, scene.dt, &error);
         }
     }
     if wanted('d') {

@@ -173,6 +173,10 @@ enum Command {
         /// print throughput, ghosts, bytes exchanged and time in the exchange.
         #[arg(long)]
         ranks: bool,
+        /// The backend that steps the scenes: cpu, or cuda (feature `cuda`, a GPU:
+        /// the sphere scenes b and c, c under Hertz–Mindlin).
+        #[arg(long, default_value = "cpu", value_parser = backend_kind)]
+        backend: talus::engine::choice::BackendKind,
         /// Instead of measuring, pour the settled bed of scene (a) and write its
         /// poses to this file (about 20 minutes on two cores).
         #[arg(long, value_name = "FILE")]
@@ -201,6 +205,16 @@ fn bench_on_ranks(_: &bench::BenchOptions) -> Result<()> {
     anyhow::bail!(
         "--ranks: this talus was built without the `mpi` feature (cargo build --features mpi)"
     )
+}
+
+/// `--backend`'s value: a backend's name as the scene's `[simulation] backend`.
+fn backend_kind(name: &str) -> Result<talus::engine::choice::BackendKind, String> {
+    use talus::engine::choice::BackendKind;
+    match name {
+        "cpu" => Ok(BackendKind::Cpu),
+        "cuda" => Ok(BackendKind::Cuda),
+        other => Err(format!("'{other}': the backends are cpu and cuda")),
+    }
 }
 
 fn main() -> Result<()> {
@@ -293,6 +307,7 @@ fn main() -> Result<()> {
             scene,
             threads,
             ranks,
+            backend,
             ..
         } => {
             let options = bench::BenchOptions {
@@ -300,8 +315,11 @@ fn main() -> Result<()> {
                 steps,
                 scenes: scene,
                 threads,
+                backend,
             };
-            if ranks {
+            if ranks && backend != talus::engine::choice::BackendKind::Cpu {
+                anyhow::bail!("--ranks: the ranks step on the cpu backend")
+            } else if ranks {
                 bench_on_ranks(&options)
             } else {
                 bench::bench(options)

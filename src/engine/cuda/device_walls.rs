@@ -12,6 +12,7 @@ use nalgebra::{Isometry3, Point3, Vector3};
 use super::Kernel;
 use super::device::{Arg, Array, Device, DeviceError};
 use super::device_list::run;
+use super::device_sums::{RowSums, groups};
 use crate::Real;
 use crate::engine::backend::WallKey;
 use crate::engine::cpu::motion::advance_walls;
@@ -34,6 +35,16 @@ struct Slots {
     springs: Array<Real>,
 }
 
+/// Doubles the rows of the walls' first pass may take together (32 MiB): a row for
+/// every 32 particles where that fits, fewer for walls of many facets (each row
+/// holds every facet).
+const WALL_ROWS_DOUBLES: usize = 1 << 22;
+
+/// Rows of the walls' first pass over `n` particles, each `width` doubles.
+fn wall_sum_rows(n: usize, width: usize) -> usize {
+    (WALL_ROWS_DOUBLES / width.max(1)).clamp(1, groups(n).max(1))
+}
+
 /// The walls on a device and their host copy (see the module).
 #[derive(Debug)]
 pub(super) struct DeviceWalls {
@@ -52,9 +63,11 @@ pub(super) struct DeviceWalls {
     records: Array<Real>,
     record_facet: Array<u32>,
     overflow: Array<u32>,
-    force: Array<Real>,
-    torque: Array<Real>,
-    facet_force: Array<Real>,
+    /// Scratch of the walls' sums.
+    sums: RowSums,
+    /// What the particles push on the walls: per wall its force and torque, then
+    /// per facet its force.
+    totals: Array<Real>,
 }
 
 /// What the wall kernel reads of the particles and their types.
@@ -101,9 +114,8 @@ impl DeviceWalls {
             records: Array::default(),
             record_facet: Array::default(),
             overflow: Array::default(),
-            force: Array::default(),
-            torque: Array::default(),
-            facet_force: Array::default(),
+            sums: RowSums::default(),
+            totals: Array::default(),
             host,
         };
         walls.wall_facets.write(device, &starts)?;
@@ -114,11 +126,9 @@ impl DeviceWalls {
         walls.material.write(device, &materials)?;
         walls.facets.resize(device, 9 * facets)?;
         walls.normals.resize(device, 3 * facets)?;
-        walls.facet_force.resize(device, 3 * facets)?;
         let count = walls.host.walls.len();
         walls.motion.resize(device, 9 * count)?;
-        walls.force.resize(device, 3 * count)?;
-        walls.torque.resize(device, 3 * count)?;
+        walls.totals.resize(device, 6 * count + 3 * facets)?;
         walls.overflow.resize(device, 1)?;
         for slots in [&mut walls.old, &mut walls.new] {
             slots.count.resize(device, n)?;
@@ -141,9 +151,7 @@ impl DeviceWalls {
             &self.old.springs,
             &self.new.springs,
             &self.records,
-            &self.force,
-            &self.torque,
-            &self.facet_force,
+            &self.totals,
         ];
         let words = [
             &self.wall_facets,
@@ -157,6 +165,7 @@ impl DeviceWalls {
             + words.iter().map(|a| a.bytes(device)).sum::<usize>()
             + self.old.keys.bytes(device)
             + self.new.keys.bytes(device)
+            + self.sums.bytes(device)
     }
 
     /// Whether there are walls.
@@ -225,7 +234,7 @@ impl DeviceWalls {
         std::mem::swap(&mut self.old, &mut self.new);
         let (old, new) = (&self.old, &self.new);
         let walls = Arg::U32(self.host.walls.len() as u32);
-        // SAFETY: the parameters of sphere_walls and sum_walls (walls.cu), every
+        // SAFETY: the parameters of sphere_walls (walls.cu), every
         // array sized for its particles, slots, walls or facets.
         unsafe {
             run(
@@ -273,10 +282,24 @@ impl DeviceWalls {
                     self.overflow.arg(),
                 ],
             )?;
+        }
+        // The walls' sums: rows of partial sums over every so-many particles, folded.
+        let facets = self
+            .host
+            .walls
+            .iter()
+            .map(|w| w.triangles.len())
+            .sum::<usize>();
+        let width = 6 * self.host.walls.len() + 3 * facets;
+        let rows = wall_sum_rows(at.n, width);
+        let partials = self.sums.rows(device, rows, width)?;
+        // SAFETY: the parameters of wall_sum_rows (walls.cu): the slots hold n
+        // particles', `partials` room for `rows` rows of `width`.
+        unsafe {
             run(
                 device,
-                Kernel::SumWalls,
-                1,
+                Kernel::WallSumRows,
+                rows,
                 &[
                     Arg::U32(at.n as u32),
                     at.position.arg(),
@@ -287,12 +310,12 @@ impl DeviceWalls {
                     new.keys.arg(),
                     self.records.arg(),
                     self.record_facet.arg(),
-                    self.force.arg(),
-                    self.torque.arg(),
-                    self.facet_force.arg(),
+                    Arg::U32(rows as u32),
+                    partials.arg(),
                 ],
             )?;
         }
+        self.sums.fold(device, rows, width, &mut self.totals)?;
         if self.overflow.get(device, 0)? != 0 {
             return Err(DeviceError::Capacity(format!(
                 "sphere touching walls at more than {SLOTS} places at once"
@@ -301,40 +324,32 @@ impl DeviceWalls {
         Ok(())
     }
 
-    /// Launches the sum of the contacts' elastic energy and dissipation over the
-    /// pairs' `results` (`pairs` of them) and the walls' contacts into `totals`.
-    pub fn sum_energies(
+    /// Launches the energy terms of `n` particles' wall contacts into records
+    /// `first..first + n` of `terms` (`device_sums.rs`).
+    pub fn energy_terms(
         &self,
         device: &mut dyn Device,
         n: usize,
-        pairs: usize,
-        results: &Array<Real>,
-        totals: &Array<Real>,
+        terms: &Array<Real>,
+        first: usize,
     ) -> Result<(), DeviceError> {
-        let walls = if self.is_empty() {
-            0
-        } else {
-            self.host.walls.len()
-        };
-        // SAFETY: the parameters of sum_energies (walls.cu); the slots hold n
-        // particles' where there are walls.
+        // SAFETY: the parameters of wall_energy_terms (walls.cu); the slots hold n
+        // particles', `terms` room for records up to first + n.
         unsafe {
             run(
                 device,
-                Kernel::SumEnergies,
-                1,
+                Kernel::WallEnergyTerms,
+                n,
                 &[
-                    Arg::U32(pairs as u32),
-                    results.arg(),
                     Arg::U32(n as u32),
-                    Arg::U32(walls as u32),
                     self.new.count.arg(),
                     self.new.keys.arg(),
                     self.records.arg(),
                     self.old.count.arg(),
                     self.old.keys.arg(),
                     self.old.springs.arg(),
-                    totals.arg(),
+                    Arg::U32(first as u32),
+                    terms.arg(),
                 ],
             )
         }
@@ -408,15 +423,15 @@ impl DeviceWalls {
     /// Copies the walls' poses, velocities, forces, torques and facet forces into
     /// `world`.
     pub fn download(&self, device: &dyn Device, world: &mut World) -> Result<(), DeviceError> {
-        let (force, torque) = (self.force.read(device)?, self.torque.read(device)?);
-        let facet_force = self.facet_force.read(device)?;
+        let totals = self.totals.read(device)?;
+        let (walls, facet_force) = totals.split_at(6 * self.host.walls.len());
         let mut first = 0;
         for (w, (wall, moved)) in world.walls.iter_mut().zip(&self.host.walls).enumerate() {
             wall.pose = moved.pose;
             wall.velocity = moved.velocity;
             wall.angular_velocity = moved.angular_velocity;
-            wall.force = Vector3::from_column_slice(&force[3 * w..3 * w + 3]);
-            wall.torque = Vector3::from_column_slice(&torque[3 * w..3 * w + 3]);
+            wall.force = Vector3::from_column_slice(&walls[6 * w..6 * w + 3]);
+            wall.torque = Vector3::from_column_slice(&walls[6 * w + 3..6 * w + 6]);
             for (f, out) in wall.facet_force.iter_mut().enumerate() {
                 let k = 3 * (first + f);
                 *out = Vector3::from_column_slice(&facet_force[k..k + 3]);

@@ -16,6 +16,7 @@
 pub mod backend;
 pub mod device;
 mod device_list;
+mod device_sums;
 mod device_walls;
 pub mod driver;
 pub mod host;
@@ -49,7 +50,7 @@ pub static CONTACT: KernelFile = KernelFile {
 };
 
 /// The kernel files, each compiled to one module.
-pub static FILES: [KernelFile; 5] = [
+pub static FILES: [KernelFile; 6] = [
     KernelFile {
         name: "integrate.cu",
         source: include_str!("../../../kernels/integrate.cu"),
@@ -73,6 +74,11 @@ pub static FILES: [KernelFile; 5] = [
     KernelFile {
         name: "walls.cu",
         source: include_str!("../../../kernels/walls.cu"),
+        headers: &[&VEC, &CONTACT],
+    },
+    KernelFile {
+        name: "sums.cu",
+        source: include_str!("../../../kernels/sums.cu"),
         headers: &[&VEC, &CONTACT],
     },
 ];
@@ -124,15 +130,19 @@ pub enum Kernel {
     CountTouching,
     /// The Hertz–Mindlin contacts of spheres with wall facets (`walls.cu`).
     SphereWalls,
-    /// The walls' forces, torques and facet forces (`walls.cu`).
-    SumWalls,
-    /// The contacts' elastic energy and dissipation, summed (`walls.cu`).
-    SumEnergies,
+    /// The walls' forces, torques and facet forces, first pass (`walls.cu`).
+    WallSumRows,
+    /// Each particle's wall contacts' energy terms (`walls.cu`).
+    WallEnergyTerms,
+    /// The pairs' energy terms, folded into partial sums (`sums.cu`).
+    PairEnergyPartials,
+    /// A pass of the deterministic sums (`sums.cu`).
+    SumRecords,
 }
 
 impl Kernel {
     /// Every kernel.
-    pub const ALL: [Kernel; 24] = [
+    pub const ALL: [Kernel; 26] = [
         Kernel::KickDrift,
         Kernel::ClosingKick,
         Kernel::BinParticles,
@@ -155,8 +165,10 @@ impl Kernel {
         Kernel::GatherForces,
         Kernel::CountTouching,
         Kernel::SphereWalls,
-        Kernel::SumWalls,
-        Kernel::SumEnergies,
+        Kernel::WallSumRows,
+        Kernel::WallEnergyTerms,
+        Kernel::PairEnergyPartials,
+        Kernel::SumRecords,
     ];
 
     /// Its name in the source (`extern "C"`, so the PTX entry has it too).
@@ -184,8 +196,10 @@ impl Kernel {
             Kernel::GatherForces => "gather_forces",
             Kernel::CountTouching => "count_touching",
             Kernel::SphereWalls => "sphere_walls",
-            Kernel::SumWalls => "sum_walls",
-            Kernel::SumEnergies => "sum_energies",
+            Kernel::WallSumRows => "wall_sum_rows",
+            Kernel::WallEnergyTerms => "wall_energy_terms",
+            Kernel::PairEnergyPartials => "pair_energy_partials",
+            Kernel::SumRecords => "sum_records",
         }
     }
 
@@ -200,7 +214,8 @@ impl Kernel {
             }
             ScanChunkTotals | ScanChunkOffsets | ScanApply | ZeroWords | CopyWords => 2,
             SphereContacts | GatherForces | CountTouching => 3,
-            SphereWalls | SumWalls | SumEnergies => 4,
+            SphereWalls | WallSumRows | WallEnergyTerms => 4,
+            PairEnergyPartials | SumRecords => 5,
         };
         &FILES[index]
     }

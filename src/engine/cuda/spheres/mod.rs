@@ -10,8 +10,8 @@
 //! particles come back by [`DeviceSpheres::download`].
 //!
 //! Walls (`device_walls.rs`) move on the host and are placed on the device; each
-//! particle's wall contacts follow its pairs' gather, and one thread sums the
-//! walls' forces in particle order.
+//! particle's wall contacts follow its pairs' gather. The walls' forces and the
+//! contacts' energies are summed in a fixed tree (`device_sums.rs`).
 //!
 //! What it does not take yet (refused by [`DeviceSpheres::new`]): polyhedra,
 //! rolling resistance, a fluid, ghosts of a decomposition, particles not stored in
@@ -24,6 +24,7 @@ mod transfer;
 use super::Kernel;
 use super::device::{Arg, Array, Device, DeviceError};
 use super::device_list::{DeviceList, ListInputs, run};
+use super::device_sums::{RowSums, sum_energies};
 use super::device_walls::{DeviceWalls, WallInputs};
 use crate::Real;
 use crate::contact::{RollingModel, pair_restitution};
@@ -102,6 +103,8 @@ pub struct DeviceSpheres {
     pairs: PairArrays,
     list: DeviceList,
     walls: DeviceWalls,
+    /// Scratch of the energy sums.
+    sums: RowSums,
     /// Pairs that touched at the last force evaluation.
     contacts: usize,
 }
@@ -185,6 +188,7 @@ impl DeviceSpheres {
             pairs: PairArrays::default(),
             list,
             walls,
+            sums: RowSums::default(),
             contacts: 0,
         };
         spheres.upload_particles(world)?;
@@ -456,8 +460,14 @@ impl DeviceSpheres {
             };
             self.walls.contacts(d, &at)?;
         }
-        pairs.energies.resize(d, 3)?;
-        self.walls
-            .sum_energies(d, self.n, count, &pairs.results, &pairs.energies)
+        sum_energies(
+            &mut self.sums,
+            d,
+            count,
+            &pairs.results,
+            &self.walls,
+            self.n,
+            &mut pairs.energies,
+        )
     }
 }

@@ -45,11 +45,13 @@ impl DeviceSpheres {
             + p.id.bytes(d)
             + self.list.bytes(d)
             + self.walls.bytes(d)
+            + self.sums.bytes(d)
     }
 
     /// The elastic energy held in the contacts and the energy they dissipated over
     /// the last step, J (the CPU backend's `StepStats::elastic_energy` and
-    /// `dissipated`, summed in its order; read back from the device).
+    /// `dissipated`, the same terms summed in a tree: equal to round-off; read back
+    /// from the device).
     pub fn energies(&self) -> Result<(Real, Real), DeviceError> {
         let e = self.pairs.energies.read(self.device.as_ref())?;
         Ok((e[0], e[1]))

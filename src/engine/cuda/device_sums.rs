@@ -1,0 +1,130 @@
+//! Deterministic sums on the device (`kernels/sums.cu`): a first pass writes rows of
+//! partial sums (each thread of it sums every so-many terms in order), then passes
+//! of many threads fold [`FAN_IN`] rows into one until one is left. The order of the
+//! additions is fixed by the number of rows and their width, so every run and every
+//! block size gives the same bits; they differ from the CPU backend's serial sums
+//! by round-off.
+//!
+//! Summed so: the contacts' elastic energy, dissipation and wall-contact count
+//! ([`sum_energies`]: the pairs' results folded into rows, one row a particle for
+//! its wall contacts), and the walls' forces, torques and facet forces
+//! (`device_walls.rs`). For a million particles with six million pairs, four
+//! passes after the first.
+
+use super::Kernel;
+use super::device::{Arg, Array, Device, DeviceError};
+use super::device_list::run;
+use super::device_walls::DeviceWalls;
+use crate::Real;
+
+/// Doubles of a row of the energy sums: elastic energy, dissipated energy, wall
+/// contacts (`ENERGY_RECORD` in `kernels/contact.cuh`).
+const ENERGY_RECORD: usize = 3;
+
+/// The rows a thread of a pass folds into one, at most.
+const FAN_IN: usize = 32;
+
+/// Threads (or groups of `width` threads) of a pass over `rows` rows: at least one,
+/// so that no rows sum to zero.
+pub(super) fn groups(rows: usize) -> usize {
+    rows.div_ceil(FAN_IN).max(1)
+}
+
+/// The rows of a sum on the device, in two arrays used in turn.
+#[derive(Debug, Default)]
+pub(super) struct RowSums {
+    rows: Array<Real>,
+    folded: Array<Real>,
+}
+
+impl RowSums {
+    /// Device memory held, bytes.
+    pub fn bytes(&self, device: &dyn Device) -> usize {
+        self.rows.bytes(device) + self.folded.bytes(device)
+    }
+
+    /// The array for the first pass's `rows` rows of `width` doubles.
+    pub fn rows(
+        &mut self,
+        device: &mut dyn Device,
+        rows: usize,
+        width: usize,
+    ) -> Result<&Array<Real>, DeviceError> {
+        self.rows.resize(device, rows * width)?;
+        self.folded.resize(device, groups(rows) * width)?;
+        Ok(&self.rows)
+    }
+
+    /// Folds the `rows` rows of `width` doubles written into [`rows`](Self::rows)
+    /// into one, written to `out` (`width` doubles).
+    pub fn fold(
+        &mut self,
+        device: &mut dyn Device,
+        mut rows: usize,
+        width: usize,
+        out: &mut Array<Real>,
+    ) -> Result<(), DeviceError> {
+        out.resize(device, width)?;
+        loop {
+            let g = groups(rows);
+            let into = if g == 1 { &*out } else { &self.folded };
+            // SAFETY: the parameters of sum_records (sums.cu): `rows` holds `rows`
+            // rows of `width`, `into` room for `g`.
+            unsafe {
+                run(
+                    device,
+                    Kernel::SumRecords,
+                    g * width,
+                    &[
+                        Arg::U32(rows as u32),
+                        Arg::U32(width as u32),
+                        self.rows.arg(),
+                        Arg::U32(g as u32),
+                        into.arg(),
+                    ],
+                )?;
+            }
+            if g == 1 {
+                return Ok(());
+            }
+            std::mem::swap(&mut self.rows, &mut self.folded);
+            rows = g;
+        }
+    }
+}
+
+/// Sums the elastic energy and dissipation in the `pairs` pairs' `results`, and in
+/// the wall contacts of `walls` for `n` particles, into `totals` (elastic energy,
+/// dissipated energy, wall contacts), by the scratch `sums`.
+pub(super) fn sum_energies(
+    sums: &mut RowSums,
+    device: &mut dyn Device,
+    pairs: usize,
+    results: &Array<Real>,
+    walls: &DeviceWalls,
+    n: usize,
+    totals: &mut Array<Real>,
+) -> Result<(), DeviceError> {
+    let first = groups(pairs);
+    let wall_rows = if walls.is_empty() { 0 } else { n };
+    let rows = sums.rows(device, first + wall_rows, ENERGY_RECORD)?;
+    // SAFETY: the parameters of pair_energy_partials (sums.cu): `results` holds
+    // `pairs` results, `rows` room for the `first` rows written.
+    unsafe {
+        run(
+            device,
+            Kernel::PairEnergyPartials,
+            first,
+            &[
+                Arg::U32(pairs as u32),
+                results.arg(),
+                Arg::U32(first as u32),
+                rows.arg(),
+            ],
+        )?;
+    }
+    if wall_rows > 0 {
+        walls.energy_terms(device, n, rows, first)?;
+    }
+    sums.fold(device, first + wall_rows, ENERGY_RECORD, totals)
+}
