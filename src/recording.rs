@@ -66,6 +66,13 @@ impl Outputs {
         }
     }
 
+    /// Whether [`record`](Self::record) after a step of length `dt` that ended at
+    /// `t` reads the particles: a row or a frame is due, or the scene has a drum
+    /// (whose monitor takes the bed's mass moments every step).
+    pub fn reads_particles(&self, t: Real, dt: Real) -> bool {
+        self.drum || self.clock().due(t, dt, false).any()
+    }
+
     /// [`RunOutput::record`] after a step of length `dt`, the whole world gathered
     /// when a row, a frame or a drum's sample is due (collective on ranks).
     pub fn record(&mut self, sim: &Simulation, dt: Real, force: bool) -> io::Result<()> {

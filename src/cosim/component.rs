@@ -466,6 +466,10 @@ impl Component {
             }
         });
         let mut output = self.output.take();
+        // Without outputs to write, the particles come back from a device backend
+        // once, at the end of the communication step (the divergence check, the
+        // outputs of the step).
+        sim.set_particles_each_step(output.is_some());
         // On ranks every rank takes every step: an output error (on rank 0 only) is
         // kept for the end of the step instead of ending it there.
         let on_ranks = self.ranks.is_some();
@@ -494,6 +498,7 @@ impl Component {
                 (ControlFlow::Continue(()), None) => Ok(()),
             }
         });
+        sim.sync_particles();
         sim.set_time(end);
         sim.move_walls(|walls| {
             for (w, position, q) in targets {

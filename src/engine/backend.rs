@@ -127,6 +127,13 @@ pub trait Backend: Send + fmt::Debug {
     /// Brings the host world's particle arrays up to date.
     fn sync_to_host(&mut self, world: &mut World);
 
+    /// Whether the particles live in the host world between steps, so that
+    /// [`sync_to_host`](Backend::sync_to_host) has nothing to copy (the CPU backend
+    /// steps the host world itself; a device backend holds them on the device).
+    fn particles_on_host(&self) -> bool {
+        true
+    }
+
     /// Where the host's world is one rank's share of a decomposed run: the other
     /// ranks, through which the host reduces its whole-run figures, gathers the
     /// whole world and inserts particles. `None` for a backend of the whole world.

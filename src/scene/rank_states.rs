@@ -148,6 +148,7 @@ impl Simulation {
             keep_fluid_share(&mut world, fluid, &state.particles.id, rank);
         }
         sim.world = world;
+        sim.particles_behind = false;
         sim.backend = Box::new(stepper);
         sim.reduce_over_ranks(HeldEnergy::default(), 0.0);
         // The walls and figures of the step that ended, as saved (the ranks' own

@@ -47,6 +47,11 @@ pub struct Simulation {
     pub(super) energy: EnergyLedger,
     /// On ranks: the whole run's figures after the last step (see [`super::ranks`]).
     pub(super) whole: Option<WholeRun>,
+    /// Whether the host world's particles are brought up to date after every step
+    /// (see [`Simulation::set_particles_each_step`]).
+    particles_each_step: bool,
+    /// Whether the backend holds particle state the host world has not received.
+    pub(super) particles_behind: bool,
 }
 
 /// Simulated time between two measurements of the bed height (while inlets feed
@@ -116,6 +121,40 @@ impl Simulation {
             fluid_interval: scene.spec.fluid.as_ref().map(|f| f.update_interval),
             energy: EnergyLedger::default(),
             whole: None,
+            particles_each_step: true,
+            particles_behind: false,
+        }
+    }
+
+    /// Whether the host world's particles are brought up to date after every step
+    /// (`true`, the default: whoever reads [`world`](Self::world) between steps sees
+    /// the step's state), or only when the simulation's own work between steps reads
+    /// or changes them (an inlet inserting, the bed measured or frozen, the settling
+    /// test, a fluid, a change through the methods here) and when
+    /// [`sync_particles`](Self::sync_particles) is called. A backend that steps on a
+    /// device copies the particles back only then (a million spheres' state is 150
+    /// MB a step); the CPU backend steps the host world itself, so nothing changes
+    /// for it. Whoever turns this off reads the particles only after a
+    /// `sync_particles`.
+    pub fn set_particles_each_step(&mut self, each: bool) {
+        self.particles_each_step = each;
+        if each {
+            self.sync_particles();
+        }
+    }
+
+    /// Whether the host world's particles are the backend's (always, unless
+    /// [`set_particles_each_step`](Self::set_particles_each_step) turned the copy
+    /// after every step off).
+    pub fn particles_current(&self) -> bool {
+        !self.particles_behind
+    }
+
+    /// Brings the host world's particles up to date with the backend's.
+    pub fn sync_particles(&mut self) {
+        if self.particles_behind {
+            self.backend.sync_to_host(&mut self.world);
+            self.particles_behind = false;
         }
     }
 
@@ -197,6 +236,7 @@ impl Simulation {
 
     /// Replaces the step parameters of the backend.
     pub fn set_params(&mut self, params: StepParams) {
+        self.sync_particles();
         self.backend.set_params(params);
     }
 
@@ -210,6 +250,7 @@ impl Simulation {
     /// Evaluates the forces of the current state with the step length to come: after
     /// the host set wall poses or velocities that the first half kick must see.
     pub fn initialise(&mut self) {
+        self.sync_particles();
         let before = self.backend.stats().elastic_energy;
         self.backend.initialise(&mut self.world, self.dt);
         self.energy
@@ -227,6 +268,7 @@ impl Simulation {
     /// Multiplies every owned particle's velocity and angular momentum by `keep` (an
     /// artificial drag that brings a bed to rest).
     pub fn damp_velocities(&mut self, keep: Real) {
+        self.sync_particles();
         let before = self.world.kinetic_energy();
         let p = &mut self.world.particles;
         let n = p.owned();
@@ -240,6 +282,7 @@ impl Simulation {
     /// up: poses, velocities); the backend takes the whole world again and the forces
     /// are evaluated anew.
     pub fn edit_world(&mut self, change: impl FnOnce(&mut World)) {
+        self.sync_particles();
         let before = self.held_energy();
         change(&mut self.world);
         self.world.particles.reindex();
@@ -252,6 +295,7 @@ impl Simulation {
     /// particle's index); the others keep their order, and the backend finds what it
     /// keeps per particle again by id. Returns how many were removed.
     pub fn remove_particles(&mut self, mut remove: impl FnMut(&World, usize) -> bool) -> usize {
+        self.sync_particles();
         let world = &self.world;
         let owned = world.particles.owned();
         let doomed: Vec<bool> = (0..world.particles.len())
@@ -286,14 +330,16 @@ impl Simulation {
     /// Advances to `end` in steps of the step length asked for, the last one shortened
     /// to land on `end`; stops within `1e-9` steps of it. After every step `each`
     /// gets the simulation and the step's length, and may stop the advance
-    /// (`Break`), which is then returned.
+    /// (`Break`), which is then returned. Where the particles are not copied back
+    /// every step ([`set_particles_each_step`](Self::set_particles_each_step)),
+    /// `each` calls [`sync_particles`](Self::sync_particles) before it reads them.
     ///
     /// The one sub-step loop of talus: `talus run`, the Component (and so the C, FMI
     /// and zenoh faces) and `talus bench` advance through it.
     pub fn advance_to<B>(
         &mut self,
         end: Real,
-        mut each: impl FnMut(&Simulation, Real) -> ControlFlow<B>,
+        mut each: impl FnMut(&mut Simulation, Real) -> ControlFlow<B>,
     ) -> ControlFlow<B> {
         while self.world.time < end - 1e-9 * self.dt {
             let taken = self.dt.min(end - self.world.time);
@@ -307,7 +353,10 @@ impl Simulation {
     fn step_by(&mut self, dt: Real) {
         let before = self.world.time;
         self.backend.step(&mut self.world, dt);
-        self.backend.sync_to_host(&mut self.world);
+        self.particles_behind = !self.backend.particles_on_host();
+        if self.particles_each_step || self.reads_particles_between_steps(before) {
+            self.sync_particles();
+        }
         self.steps = self.steps.saturating_add(1);
         let freezing = self.follow_bed(before);
         let inserted = self.insert();
@@ -323,6 +372,26 @@ impl Simulation {
             self.update_fluid();
         }
         self.update_settling();
+    }
+
+    /// Whether the host's work after the step that began at `before` reads or changes
+    /// the particles: inlets still inserting, the bed measured, the settling test, a
+    /// fluid, ranks.
+    fn reads_particles_between_steps(&self, before: Real) -> bool {
+        !self.inlets_done()
+            || self.bed_measured_after(before)
+            || self.settle.is_some()
+            || self.world.fluid.is_some()
+            || self.backend.share().is_some()
+    }
+
+    /// Whether the bed is measured after the step that began at `before`: while
+    /// something depends on it, at the multiples of [`BED_HEIGHT_INTERVAL`].
+    fn bed_measured_after(&self, before: Real) -> bool {
+        self.bed.is_some()
+            && (self.freeze.is_some() || self.inlets.iter().any(feeds_by_the_bed))
+            && (before / BED_HEIGHT_INTERVAL).floor()
+                != (self.world.time / BED_HEIGHT_INTERVAL).floor()
     }
 
     /// Lets the inlets insert what is due; returns the energy the particles
@@ -355,14 +424,10 @@ impl Simulation {
     /// those fed above the bed, and freezes the buried particles. Returns the
     /// kinetic energy the freezing took (negative), J.
     fn follow_bed(&mut self, before: Real) -> Real {
-        let Some(bed) = &self.bed else { return 0.0 };
-        let feeding = |i: &Inlet| (i.stop_height.is_some() || i.above_bed) && !i.is_done();
-        if !(self.freeze.is_some() || self.inlets.iter().any(feeding))
-            || (before / BED_HEIGHT_INTERVAL).floor()
-                == (self.world.time / BED_HEIGHT_INTERVAL).floor()
-        {
+        if !self.bed_measured_after(before) {
             return 0.0;
         }
+        let Some(bed) = &self.bed else { return 0.0 };
         // The bed: what touches something and moves slower than half of √(g d)
         // (not particles in flight, nor those sliding down the tube wall). Nothing
         // yet: no bed.
@@ -387,7 +452,7 @@ impl Simulation {
             return 0.0;
         };
         self.bed_height = Some(height);
-        for inlet in self.inlets.iter_mut().filter(|i| feeding(i)) {
+        for inlet in self.inlets.iter_mut().filter(|i| feeds_by_the_bed(i)) {
             if inlet.stop_height.is_some_and(|h| height >= h) {
                 inlet.stop();
             }
@@ -491,6 +556,11 @@ impl Simulation {
             (false, _) => None,
         };
     }
+}
+
+/// Whether `inlet` still feeds until a bed height or above the bed.
+fn feeds_by_the_bed(inlet: &Inlet) -> bool {
+    (inlet.stop_height.is_some() || inlet.above_bed) && !inlet.is_done()
 }
 
 /// Freezes the particles in `member` (the bed) that are slower than the freeze speed

@@ -176,6 +176,7 @@ impl Simulation {
         let world = &mut self.world;
         world.time = state.time;
         world.particles = state.particles.clone();
+        self.particles_behind = false;
         for (wall, s) in world.walls.iter_mut().zip(&state.walls) {
             wall.pose = s.pose;
             wall.velocity = s.velocity;

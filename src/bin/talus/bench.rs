@@ -427,6 +427,8 @@ fn measure(scene: &Scene, threads: usize, warmup: usize, steps: usize) -> Result
         .build()?;
     Ok(pool.install(|| {
         let mut sim = Simulation::new(scene);
+        // The bench reads figures between steps, not particles.
+        sim.set_particles_each_step(false);
         let dt = sim.dt();
         let warm = sim.time() + warmup as f64 * dt;
         let _ = sim.advance_to(warm, |_, _| ControlFlow::<()>::Continue(()));

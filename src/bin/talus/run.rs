@@ -209,13 +209,25 @@ fn run_loop(
     // balance of the last BALANCE_STEPS steps broken grossly.
     let mut blown_up: Option<String> = None;
     let mut balance = EnergyBalance::start(&sim);
+    // The particles come back from a device backend only for the steps that read
+    // them: a row, a frame or a checkpoint due, the drum's monitor, the energy
+    // balance (the CPU backend steps the host's world itself).
+    sim.set_particles_each_step(false);
     let ended_by = match stopped(&sim) {
         Some(reason) => reason,
         None => {
             let end = sim.end_time;
             let advanced = sim.advance_to(end, |sim, taken| {
+                let balance_due = sim.steps % BALANCE_STEPS == 0;
+                let checkpoint_due = checkpoints.due(sim, taken);
+                if balance_due || checkpoint_due || out.reads_particles(sim.time(), taken) {
+                    sim.sync_particles();
+                }
+                let sim = &*sim;
                 // Before anything of this step is written: the outputs stay finite.
-                if let Some(id) = sim.first_non_finite() {
+                if sim.particles_current()
+                    && let Some(id) = sim.first_non_finite()
+                {
                     blown_up = Some(format!(
                         "particle {id} went non-finite (position, velocity or force) in step {} \
                          at t = {:.6e} s; the outputs hold the run up to the step before{}",
@@ -230,7 +242,7 @@ fn run_loop(
                     ));
                     return ControlFlow::Break(Ok("diverged"));
                 }
-                if sim.steps % BALANCE_STEPS == 0 {
+                if balance_due {
                     if let Some(problem) = balance.broken(sim) {
                         blown_up = Some(format!(
                             "in the {BALANCE_STEPS} steps up to step {} (t = {:.6e} s), {problem}; \
@@ -248,13 +260,14 @@ fn run_loop(
                 if let Err(e) = out.record(sim, taken, false) {
                     return ControlFlow::Break(Err(e.into()));
                 }
-                if checkpoints.due(sim, taken)
+                if checkpoint_due
                     && let Err(e) =
                         checkpoints.write(sim, &mut out, progress(contact_sum, particle_steps))
                 {
                     return ControlFlow::Break(Err(e));
                 }
-                if last_draw.elapsed() > Duration::from_millis(200) {
+                // The energy error reads the particles: drawn with them current.
+                if last_draw.elapsed() > Duration::from_millis(200) && sim.particles_current() {
                     last_draw = Instant::now();
                     bar.set_position(sim.steps);
                     bar.set_message(format!(
@@ -276,6 +289,7 @@ fn run_loop(
             }
         }
     };
+    sim.sync_particles();
     bar.finish_and_clear();
     if ended_by == "interrupted" {
         // Before the last frame and row, which an uninterrupted run would not write.

@@ -194,4 +194,8 @@ impl Backend for CudaBackend {
             spheres.particles_to_host(world).unwrap_or_else(|e| fail(e));
         }
     }
+
+    fn particles_on_host(&self) -> bool {
+        false
+    }
 }

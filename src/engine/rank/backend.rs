@@ -99,6 +99,10 @@ impl<E: Exchange + Send + fmt::Debug> Backend for RankStepper<E> {
         self.backend.sync_to_host(world);
     }
 
+    fn particles_on_host(&self) -> bool {
+        self.backend.particles_on_host()
+    }
+
     fn share(&self) -> Option<&dyn Share> {
         Some(self)
     }
