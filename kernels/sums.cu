@@ -1,10 +1,29 @@
 // Deterministic sums of records (rows of `width` doubles) in passes of many
 // threads (engine/cuda/device_sums.rs). A pass folds `count` records into
 // `groups`: thread (t, c) sums column c of records t, t + groups, t + 2 groups, …
-// in that order (neighbouring threads read neighbouring doubles). The passes repeat
+// (neighbouring threads read neighbouring doubles) into four partial sums in turn,
+// so that four loads are in flight, then adds them pairwise. The passes repeat
 // until one record is left. The order of the additions is fixed by the count of
 // records and the width alone, so every run and every block size gives the same
 // bits; they differ from a serial sum of the same terms by round-off.
+
+// The terms at[0], at[step], at[2 step], … below `end` (as offsets), summed into
+// four partial sums in turn and those added pairwise.
+static __device__ __forceinline__ double strided_sum(const double* at, size_t end,
+                                                     size_t step) {
+    double a0 = 0.0, a1 = 0.0, a2 = 0.0, a3 = 0.0;
+    size_t k = 0;
+    for (; k + 3 * step < end; k += 4 * step) {
+        a0 += at[k];
+        a1 += at[k + step];
+        a2 += at[k + 2 * step];
+        a3 += at[k + 3 * step];
+    }
+    for (; k < end; k += step) {
+        a0 += at[k];
+    }
+    return (a0 + a1) + (a2 + a3);
+}
 
 extern "C" __global__ void sum_records(unsigned count, unsigned width, const double* in,
                                        unsigned groups, double* out) {
@@ -13,11 +32,10 @@ extern "C" __global__ void sum_records(unsigned count, unsigned width, const dou
         return;
     }
     unsigned t = g / width, c = g % width;
-    double sum = 0.0;
-    for (unsigned r = t; r < count; r += groups) {
-        sum += in[(size_t)width * r + c];
-    }
-    out[(size_t)width * t + c] = sum;
+    size_t first = (size_t)width * t + c;
+    out[first] = count > t ? strided_sum(in + first, (size_t)width * (count - t),
+                                         (size_t)width * groups)
+                           : 0.0;
 }
 
 // The first pass over the pairs' results (contact.cuh): thread t of `groups` sums
@@ -29,12 +47,10 @@ extern "C" __global__ void pair_energy_partials(unsigned pair_count, const doubl
     if (t >= groups) {
         return;
     }
-    double energy = 0.0, dissipated = 0.0;
-    for (unsigned e = t; e < pair_count; e += groups) {
-        energy += results[RESULT_DOUBLES * e + 9];
-        dissipated += results[RESULT_DOUBLES * e + 10];
-    }
-    records[ENERGY_RECORD * t] = energy;
-    records[ENERGY_RECORD * t + 1] = dissipated;
+    size_t first = (size_t)RESULT_DOUBLES * t;
+    size_t end = pair_count > t ? (size_t)RESULT_DOUBLES * (pair_count - t) : 0;
+    size_t step = (size_t)RESULT_DOUBLES * groups;
+    records[ENERGY_RECORD * t] = strided_sum(results + first + 9, end, step);
+    records[ENERGY_RECORD * t + 1] = strided_sum(results + first + 10, end, step);
     records[ENERGY_RECORD * t + 2] = 0.0;
 }

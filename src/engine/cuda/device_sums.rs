@@ -1,9 +1,9 @@
 //! Deterministic sums on the device (`kernels/sums.cu`): a first pass writes rows of
-//! partial sums (each thread of it sums every so-many terms in order), then passes
+//! partial sums (each of its threads sums up to [`FIRST_FAN_IN`] terms), then passes
 //! of many threads fold [`FAN_IN`] rows into one until one is left. The order of the
-//! additions is fixed by the number of rows and their width, so every run and every
-//! block size gives the same bits; they differ from the CPU backend's serial sums
-//! by round-off.
+//! additions is fixed by the number of terms, rows and their width, so every run and
+//! every block size gives the same bits; they differ from the CPU backend's serial
+//! sums by round-off.
 //!
 //! Summed so: the contacts' elastic energy, dissipation and wall-contact count
 //! ([`sum_energies`]: the pairs' results folded into rows, one row a particle for
@@ -24,10 +24,20 @@ const ENERGY_RECORD: usize = 3;
 /// The rows a thread of a pass folds into one, at most.
 const FAN_IN: usize = 32;
 
+/// The terms a thread of a first pass sums into a row, at most: fewer than a fold
+/// takes, for more threads to hide the latency of loads scattered over the pairs or
+/// the particles' slots.
+const FIRST_FAN_IN: usize = 8;
+
 /// Threads (or groups of `width` threads) of a pass over `rows` rows: at least one,
 /// so that no rows sum to zero.
-pub(super) fn groups(rows: usize) -> usize {
+fn groups(rows: usize) -> usize {
     rows.div_ceil(FAN_IN).max(1)
+}
+
+/// Rows of a first pass over `terms` terms: at least one.
+pub(super) fn first_rows(terms: usize) -> usize {
+    terms.div_ceil(FIRST_FAN_IN).max(1)
 }
 
 /// The rows of a sum on the device, in two arrays used in turn.
@@ -105,7 +115,7 @@ pub(super) fn sum_energies(
     n: usize,
     totals: &mut Array<Real>,
 ) -> Result<(), DeviceError> {
-    let first = groups(pairs);
+    let first = first_rows(pairs);
     let wall_rows = if walls.is_empty() { 0 } else { n };
     let rows = sums.rows(device, first + wall_rows, ENERGY_RECORD)?;
     // SAFETY: the parameters of pair_energy_partials (sums.cu): `results` holds

@@ -12,7 +12,7 @@ use nalgebra::{Isometry3, Point3, Vector3};
 use super::Kernel;
 use super::device::{Arg, Array, Device, DeviceError};
 use super::device_list::run;
-use super::device_sums::{RowSums, groups};
+use super::device_sums::{RowSums, first_rows};
 use crate::Real;
 use crate::engine::backend::WallKey;
 use crate::engine::cpu::motion::advance_walls;
@@ -36,13 +36,13 @@ struct Slots {
 }
 
 /// Doubles the rows of the walls' first pass may take together (32 MiB): a row for
-/// every 32 particles where that fits, fewer for walls of many facets (each row
+/// every 8 particles where that fits, fewer for walls of many facets (each row
 /// holds every facet).
 const WALL_ROWS_DOUBLES: usize = 1 << 22;
 
 /// Rows of the walls' first pass over `n` particles, each `width` doubles.
 fn wall_sum_rows(n: usize, width: usize) -> usize {
-    (WALL_ROWS_DOUBLES / width.max(1)).clamp(1, groups(n).max(1))
+    (WALL_ROWS_DOUBLES / width.max(1)).clamp(1, first_rows(n))
 }
 
 /// The walls on a device and their host copy (see the module).
