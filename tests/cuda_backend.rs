@@ -7,7 +7,8 @@
 
 use std::path::Path;
 
-use nalgebra::Vector3;
+mod common;
+use common::{close, near};
 
 use talus::engine::cuda::backend::CudaBackend;
 use talus::engine::cuda::device::HostDevice;
@@ -49,17 +50,6 @@ material = "glass"
 min = [0.0, 0.0, 0.0]
 max = [0.05, 0.05, 0.02]
 "#;
-
-/// Equal to 1e-12 of the larger: two sums of the same terms in other orders (a
-/// few hundred terms, each sum's round-off within a few ulps of its terms').
-fn close(a: f64, b: f64) -> bool {
-    (a - b).abs() <= 1e-12 * a.abs().max(b.abs())
-}
-
-/// Vectors equal to 1e-12 of the longer: the walls' sums.
-fn near(a: &Vector3<f64>, b: &Vector3<f64>) -> bool {
-    (a - b).norm() <= 1e-12 * a.norm().max(b.norm())
-}
 
 /// 2000 steps: the particles and the step's figures equal the CPU backend's at
 /// every hundredth step, and the box's force, torque and facet forces and the

@@ -9,6 +9,9 @@
 
 use std::path::Path;
 
+mod common;
+use common::{close, near};
+
 use nalgebra::{Point3, UnitQuaternion, Vector3};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
@@ -152,18 +155,6 @@ struct Parity {
     last_pairs: usize,
     builds: u64,
     bytes: usize,
-}
-
-/// Equal to 1e-12 of the larger: two sums of the same terms in other orders (the
-/// device's tree, the CPU's serial sum; some thousand terms, each sum's round-off
-/// within a few ulps of its terms').
-fn close(a: f64, b: f64) -> bool {
-    (a - b).abs() <= 1e-12 * a.abs().max(b.abs())
-}
-
-/// Vectors equal to 1e-12 of the longer: the walls' sums.
-fn near(a: &Vector3<f64>, b: &Vector3<f64>) -> bool {
-    (a - b).norm() <= 1e-12 * a.norm().max(b.norm())
 }
 
 /// `steps` steps of `start` on `device` and in the CPU backend: positions,

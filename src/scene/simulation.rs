@@ -376,13 +376,12 @@ impl Simulation {
 
     /// Whether the host's work after the step that began at `before` reads or changes
     /// the particles: inlets still inserting, the bed measured, the settling test, a
-    /// fluid, ranks.
+    /// fluid. (Ranks step the host world itself: nothing to copy there.)
     fn reads_particles_between_steps(&self, before: Real) -> bool {
         !self.inlets_done()
             || self.bed_measured_after(before)
             || self.settle.is_some()
             || self.world.fluid.is_some()
-            || self.backend.share().is_some()
     }
 
     /// Whether the bed is measured after the step that began at `before`: while

@@ -210,3 +210,15 @@ pub fn fluid_swirl(cells: usize, phase: f64) -> Vec<f64> {
         })
         .collect()
 }
+
+/// Equal to 1e-12 of the larger: two sums of the same terms in other orders (the
+/// CUDA backend's tree of sums, the CPU backend's serial sum; some thousand terms,
+/// each sum's round-off within a few ulps of its terms').
+pub fn close(a: f64, b: f64) -> bool {
+    (a - b).abs() <= 1e-12 * a.abs().max(b.abs())
+}
+
+/// Vectors equal to 1e-12 of the longer: the walls' sums, as [`close`].
+pub fn near(a: &nalgebra::Vector3<f64>, b: &nalgebra::Vector3<f64>) -> bool {
+    (a - b).norm() <= 1e-12 * a.norm().max(b.norm())
+}

@@ -421,6 +421,29 @@ struct Measured {
     contact_rate: f64,
 }
 
+impl Measured {
+    /// The figures of `steps` timed steps that took `seconds` and summed
+    /// `contact_sum` contacts, ending with `particles` and `pairs`.
+    fn new(
+        stages: Vec<(&'static str, f64)>,
+        particles: usize,
+        pairs: usize,
+        contact_sum: usize,
+        steps: usize,
+        seconds: f64,
+    ) -> Self {
+        let steps = steps.max(1);
+        Measured {
+            stages,
+            particles,
+            pairs,
+            contacts: contact_sum as f64 / steps as f64,
+            particle_steps: (particles * steps) as f64 / seconds,
+            contact_rate: contact_sum as f64 / seconds,
+        }
+    }
+}
+
 fn measure(scene: &Scene, threads: usize, warmup: usize, steps: usize) -> Result<Measured> {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
@@ -441,16 +464,14 @@ fn measure(scene: &Scene, threads: usize, warmup: usize, steps: usize) -> Result
             taken += 1;
             ControlFlow::<()>::Continue(())
         });
-        let s = t.elapsed().as_secs_f64();
-        let steps = taken.max(1);
-        Measured {
-            stages: sim.stage_times().since(&before).shares(),
-            particles: sim.world().particles.len(),
-            pairs: sim.stats().candidate_pairs,
-            contacts: contacts as f64 / steps as f64,
-            particle_steps: (sim.world().particles.len() * steps) as f64 / s,
-            contact_rate: contacts as f64 / s,
-        }
+        Measured::new(
+            sim.stage_times().since(&before).shares(),
+            sim.world().particles.len(),
+            sim.stats().candidate_pairs,
+            contacts,
+            taken,
+            t.elapsed().as_secs_f64(),
+        )
     }))
 }
 
@@ -474,16 +495,14 @@ fn measure_backend(scene: &Scene, warmup: usize, steps: usize) -> Result<Measure
         backend.step(&mut world, dt);
         contacts += backend.stats().contacts;
     }
-    let s = t.elapsed().as_secs_f64();
-    let steps = steps.max(1);
-    Ok(Measured {
-        stages: backend.stage_times().since(&before).shares(),
-        particles: world.particles.len(),
-        pairs: backend.stats().candidate_pairs,
-        contacts: contacts as f64 / steps as f64,
-        particle_steps: (world.particles.len() * steps) as f64 / s,
-        contact_rate: contacts as f64 / s,
-    })
+    Ok(Measured::new(
+        backend.stage_times().since(&before).shares(),
+        world.particles.len(),
+        backend.stats().candidate_pairs,
+        contacts,
+        steps,
+        t.elapsed().as_secs_f64(),
+    ))
 }
 
 /// One row of the table and the stage shares below it.
