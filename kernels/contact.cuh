@@ -4,9 +4,12 @@
 // backend's operations in its order. Compiled after vec.cuh.
 
 #define HISTORY_DOUBLES 4u
-// A record of the energy sums (sums.cu): elastic energy, dissipated, wall contacts.
-#define ENERGY_RECORD 3u
-#define RESULT_DOUBLES 11u
+// A record of the energy sums (sums.cu): elastic energy, dissipated, wall contacts,
+// pair contacts.
+#define ENERGY_RECORD 4u
+#define RESULT_DOUBLES 9u
+// A pair's energy terms (spheres.cu): elastic energy, dissipated.
+#define PAIR_ENERGY_DOUBLES 2u
 #define MATERIAL_DOUBLES 5u
 
 // 2 √(5/6), the factor of the damping coefficients.

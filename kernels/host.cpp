@@ -59,7 +59,7 @@ static const Entry kernels[] = {
     KERNEL(pair_keys),         KERNEL(carry_history),    KERNEL(moved_too_far),
     KERNEL(copy_doubles),      KERNEL(scan_chunk_totals), KERNEL(scan_chunk_offsets),
     KERNEL(scan_apply),        KERNEL(zero_words),       KERNEL(copy_words),
-    KERNEL(sphere_contacts),   KERNEL(gather_forces),    KERNEL(count_touching),
+    KERNEL(sphere_contacts),   KERNEL(gather_forces),
     KERNEL(sphere_walls),      KERNEL(wall_sum_rows),    KERNEL(wall_energy_terms),
     KERNEL(pair_energy_partials), KERNEL(sum_records),
 };

@@ -7,7 +7,8 @@
 // material; per pair of materials (row-major) E*, G*, β, √(4G*/E*) and the friction
 // coefficient; per pair its tangential history (spring, 3 doubles, and the stiffness it was stretched at)
 // and its result (force on the second particle, torque on the first and on the
-// second, elastic energy, energy dissipated: 11 doubles) and whether it touches.
+// second: 9 doubles), its energy terms (elastic energy, energy dissipated: apart
+// from the results, so that their sums read them in a row) and whether it touches.
 
 // One thread per candidate pair: its contact, if the spheres overlap and one of
 // them moves, into its result; its history replaced by what the contact leaves
@@ -17,7 +18,8 @@ extern "C" __global__ void sphere_contacts(
     const double* velocity, const double* angular_momentum, const unsigned* body_type,
     const unsigned char* frozen, const double* type_radius, const double* type_inverse_mass,
     const double* type_inverse_inertia, const unsigned* type_material, unsigned materials,
-    const double* material_pairs, double* history, double* results, unsigned char* touching) {
+    const double* material_pairs, double* history, double* results, double* energies,
+    unsigned char* touching) {
     unsigned e = blockIdx.x * blockDim.x + threadIdx.x;
     if (e >= pair_count) {
         return;
@@ -28,6 +30,7 @@ extern "C" __global__ void sphere_contacts(
     Spring before = Spring{load3(history + HISTORY_DOUBLES * e, 0),
                            history[HISTORY_DOUBLES * e + 3]};
     double* result = results + RESULT_DOUBLES * e;
+    double* energy = energies + PAIR_ENERGY_DOUBLES * e;
     Vec3 xi = load3(position, i), xj = load3(position, j);
     Vec3 d = sub(xj, xi);
     double distance_squared = norm_squared(d);
@@ -39,10 +42,12 @@ extern "C" __global__ void sphere_contacts(
         for (unsigned k = 0; k < RESULT_DOUBLES; ++k) {
             result[k] = 0.0;
         }
+        energy[0] = 0.0;
+        energy[1] = 0.0;
         touching[e] = 0;
         if (held) {
             // The friction spring's energy is let go with the contact.
-            result[10] = spring_energy(before);
+            energy[1] = spring_energy(before);
             for (unsigned k = 0; k < HISTORY_DOUBLES; ++k) {
                 history[HISTORY_DOUBLES * e + k] = 0.0;
             }
@@ -70,8 +75,8 @@ extern "C" __global__ void sphere_contacts(
     store3(result, 0, force);
     store3(result, 1, reaction);
     store3(result, 2, torque);
-    result[9] = c.energy;
-    result[10] = c.dissipated;
+    energy[0] = c.energy;
+    energy[1] = c.dissipated;
     touching[e] = 1;
     history[HISTORY_DOUBLES * e] = kept.spring.x;
     history[HISTORY_DOUBLES * e + 1] = kept.spring.y;
@@ -106,13 +111,4 @@ extern "C" __global__ void gather_forces(
     store3(force, k, f);
     store3(torque, k, t);
     touching[k] = touches;
-}
-
-// One thread per pair: counts the pairs that touch (*count zeroed before).
-extern "C" __global__ void count_touching(unsigned pair_count, const unsigned char* touching,
-                                          unsigned* count) {
-    unsigned e = blockIdx.x * blockDim.x + threadIdx.x;
-    if (e < pair_count && touching[e]) {
-        atomicAdd(count, 1u);
-    }
 }

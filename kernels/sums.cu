@@ -38,19 +38,26 @@ extern "C" __global__ void sum_records(unsigned count, unsigned width, const dou
                            : 0.0;
 }
 
-// The first pass over the pairs' results (contact.cuh): thread t of `groups` sums
-// the elastic energy and the dissipation of pairs t, t + groups, … into record t
-// of `records` (ENERGY_RECORD doubles: energy, dissipated, wall contacts = 0).
-extern "C" __global__ void pair_energy_partials(unsigned pair_count, const double* results,
+// The first pass over the pairs' energy terms (spheres.cu): thread t of `groups`
+// sums the elastic energy and the dissipation of pairs t, t + groups, … into record
+// t of `records` (ENERGY_RECORD doubles: energy, dissipated, wall contacts = 0, and
+// the pairs that touch, counted exactly).
+extern "C" __global__ void pair_energy_partials(unsigned pair_count, const double* energies,
+                                                const unsigned char* touching,
                                                 unsigned groups, double* records) {
     unsigned t = blockIdx.x * blockDim.x + threadIdx.x;
     if (t >= groups) {
         return;
     }
-    size_t first = (size_t)RESULT_DOUBLES * t;
-    size_t end = pair_count > t ? (size_t)RESULT_DOUBLES * (pair_count - t) : 0;
-    size_t step = (size_t)RESULT_DOUBLES * groups;
-    records[ENERGY_RECORD * t] = strided_sum(results + first + 9, end, step);
-    records[ENERGY_RECORD * t + 1] = strided_sum(results + first + 10, end, step);
+    size_t first = (size_t)PAIR_ENERGY_DOUBLES * t;
+    size_t end = pair_count > t ? (size_t)PAIR_ENERGY_DOUBLES * (pair_count - t) : 0;
+    size_t step = (size_t)PAIR_ENERGY_DOUBLES * groups;
+    records[ENERGY_RECORD * t] = strided_sum(energies + first, end, step);
+    records[ENERGY_RECORD * t + 1] = strided_sum(energies + first + 1, end, step);
     records[ENERGY_RECORD * t + 2] = 0.0;
+    unsigned touches = 0;
+    for (unsigned e = t; e < pair_count; e += groups) {
+        touches += touching[e];
+    }
+    records[ENERGY_RECORD * t + 3] = (double)touches;
 }

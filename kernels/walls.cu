@@ -333,4 +333,5 @@ extern "C" __global__ void wall_energy_terms(unsigned n, const unsigned* count,
     record[0] = energy;
     record[1] = dissipated;
     record[2] = (double)count[i];
+    record[3] = 0.0;
 }

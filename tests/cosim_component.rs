@@ -44,6 +44,7 @@ fn the_variable_table_names_inputs_outputs_and_units() {
         "dt",
         "output_dir",
         "threads",
+        "backend",
         "drum.velocity",
         "drum.angular_velocity",
         "drum.force",

@@ -155,7 +155,9 @@ fn particles_copied_back_when_asked_give_the_same_run() {
     asked.step();
     assert_ne!(every.world().particles.position, kept);
     assert_eq!(asked.world().particles.position, kept, "not copied back");
+    assert_ne!(every.backend().touching(), asked.backend().touching());
     asked.sync_particles();
+    assert_eq!(every.backend().touching(), asked.backend().touching());
     let (a, b) = (every.world(), asked.world());
     assert_eq!(a.particles.id, b.particles.id);
     assert_eq!(a.particles.position, b.particles.position);
@@ -209,4 +211,79 @@ fn a_scene_asking_for_the_cuda_backend_is_checked_when_read() {
     // The CPU backend stays the default.
     let scene = Scene::parse(POUR, Path::new("pour.toml")).unwrap();
     assert_eq!(Simulation::new(&scene).backend().name(), "cpu");
+}
+
+/// The Component's parameter `backend` chooses what steps the scene: "cpu" by
+/// default (the scene's), a name that is no backend refused, "cuda" refused with
+/// the reason where there is no GPU driver (the parameter left as it was) and, on a
+/// machine with a GPU, the component steps on it as the CPU's does (particles to the
+/// bit, the box's mean force to round-off). Fixed once initialisation starts.
+#[test]
+fn the_component_parameter_backend_chooses_what_steps_the_scene() {
+    use talus::cosim::{Component, CosimError, VarRef};
+    let dir = std::env::temp_dir().join(format!("talus-backend-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("pour.toml"), POUR).unwrap();
+    let open = || Component::instantiate(&dir, "pour.toml").unwrap();
+    let backend = |c: &Component| {
+        let var = c.variable("backend").unwrap();
+        c.get_string(&[VarRef { var, element: 0 }]).unwrap()[0].clone()
+    };
+    let set = |c: &mut Component, name: &str| {
+        let var = c.variable("backend").unwrap();
+        c.set_string(&[VarRef { var, element: 0 }], &[name])
+    };
+    let mut cpu = open();
+    assert_eq!(backend(&cpu), "cpu");
+    let e = set(&mut cpu, "gpu").unwrap_err();
+    assert!(matches!(e, CosimError::BadValue { .. }));
+    assert_eq!(
+        e.to_string(),
+        "variable 'backend': 'gpu': the backends are cpu and cuda"
+    );
+    assert_eq!(backend(&cpu), "cpu");
+
+    let mut gpu = open();
+    if let Err(e) = set(&mut gpu, "cuda") {
+        assert_eq!(
+            e.to_string(),
+            "variable 'backend': cuda: no CUDA driver (libcuda) is found: the cuda backend \
+             needs an NVIDIA GPU and its driver"
+        );
+        assert_eq!(backend(&gpu), "cpu");
+        assert!(
+            std::env::var_os("TALUS_REQUIRE_GPU").is_none(),
+            "TALUS_REQUIRE_GPU is set: {e}"
+        );
+        eprintln!("no GPU driver: the component's cuda run is not checked here");
+        return;
+    }
+    assert_eq!(backend(&gpu), "cuda");
+    for c in [&mut cpu, &mut gpu] {
+        c.enter_initialization_mode(0.0).unwrap();
+        c.exit_initialization_mode().unwrap();
+    }
+    assert_eq!(gpu.simulation().unwrap().backend().name(), "cuda");
+    assert!(
+        set(&mut gpu, "cpu").is_err(),
+        "fixed once initialisation starts"
+    );
+    let force = cpu.variable("box.force").unwrap();
+    for k in 0..20 {
+        let t = k as f64 * 2e-3;
+        cpu.do_step(t, 2e-3).unwrap();
+        gpu.do_step(t, 2e-3).unwrap();
+        let (a, b) = (&cpu.world().particles, &gpu.world().particles);
+        assert_eq!(a.id, b.id, "step {k}");
+        assert_eq!(a.position, b.position, "step {k}");
+        assert_eq!(a.velocity, b.velocity, "step {k}");
+        let (f, g) = (
+            cpu.get_real_vector(force).unwrap(),
+            gpu.get_real_vector(force).unwrap(),
+        );
+        for (x, y) in f.iter().zip(&g) {
+            assert!(close(*x, *y), "box.force {f:?} against {g:?}");
+        }
+    }
+    assert!(cpu.world().particles.len() > 100);
 }

@@ -1,11 +1,14 @@
 //! The CUDA kernels compile with NVRTC (no GPU needed) for every architecture talus
-//! supports, and a kernel NVRTC refuses is reported with its file and NVRTC's log.
+//! supports, once per process, and a kernel NVRTC refuses is reported with its file
+//! and NVRTC's log.
 //! Where no NVRTC library is found the test says so and passes, unless
 //! `TALUS_REQUIRE_NVRTC` is set, as the test script sets it after installing PyPI's
 //! `nvidia-cuda-nvrtc-cu12`.
 #![cfg(feature = "cuda")]
 
-use talus::engine::cuda::nvrtc::{ARCHITECTURES, NvrtcError, compile, compile_source, is_present};
+use talus::engine::cuda::nvrtc::{
+    ARCHITECTURES, NvrtcError, compilations, compile, compile_source, is_present,
+};
 use talus::engine::cuda::{FILES, Kernel};
 
 #[test]
@@ -25,7 +28,7 @@ fn every_kernel_compiles_with_nvrtc_for_every_architecture() {
             // scripts/ptxas-report.sh reads the PTX from here.
             if let Some(dir) = std::env::var_os("TALUS_PTX_DIR") {
                 let name = format!("{}.{arch}.ptx", file.name.trim_end_matches(".cu"));
-                std::fs::write(std::path::Path::new(&dir).join(name), &ptx).unwrap();
+                std::fs::write(std::path::Path::new(&dir).join(name), ptx.as_bytes()).unwrap();
             }
             assert!(ptx.contains(&format!(".target {arch}")), "{arch}");
             let kernels = Kernel::ALL
@@ -39,6 +42,17 @@ fn every_kernel_compiles_with_nvrtc_for_every_architecture() {
                     file.name
                 );
             }
+        }
+    }
+    // Compiled once per process: asked again, the same text without NVRTC.
+    for file in &FILES {
+        for arch in ARCHITECTURES {
+            let first = compile(file, arch).unwrap();
+            assert!(std::sync::Arc::ptr_eq(
+                &first,
+                &compile(file, arch).unwrap()
+            ));
+            assert_eq!(compilations(file, arch), 1, "{} for {arch}", file.name);
         }
     }
     // Every kernel belongs to a file that was compiled.

@@ -7,6 +7,7 @@ use super::{CosimError, VarRef};
 use nalgebra::Vector3;
 
 use crate::Real;
+use crate::engine::choice::BackendKind;
 use crate::scene::{MAX_THREADS, Scene};
 
 const ANY_BUT_ERROR: &str = "instantiated, initialisation, step, terminated";
@@ -165,7 +166,12 @@ impl Component {
                 Some(Some(source)) => source[k / 3][k % 3],
                 _ => fluid.map_or(0.0, |f| f.momentum_source(k / 3)[k % 3]),
             },
-            Role::Scene | Role::OutputDir | Role::Threads | Role::Particles | Role::Contacts => {
+            Role::Scene
+            | Role::OutputDir
+            | Role::Threads
+            | Role::Backend
+            | Role::Particles
+            | Role::Contacts => {
                 unreachable!("not a real variable")
             }
         }
@@ -362,6 +368,7 @@ impl Component {
                 Ok(match v.role {
                     Role::Scene => self.params.scene.clone(),
                     Role::OutputDir => self.params.output_dir.clone(),
+                    Role::Backend => self.params.backend.name().to_string(),
                     _ => unreachable!("not a string variable"),
                 })
             })
@@ -396,10 +403,30 @@ impl Component {
                     }
                     params.scene = x.to_string();
                     params.dt = loaded.dt;
+                    params.backend = loaded.backend();
                     scene = Some(loaded);
                 }
                 Role::Scene => {}
                 Role::OutputDir => params.output_dir = x.to_string(),
+                Role::Backend => {
+                    let bad = |problem: String| CosimError::BadValue {
+                        name: v.name.clone(),
+                        problem,
+                    };
+                    let kind: BackendKind = x.parse().map_err(bad)?;
+                    if self.mode != Mode::Instantiated && kind != params.backend {
+                        return Err(bad("the backend is fixed once initialisation starts".into()));
+                    }
+                    if self.ranks.is_some() && kind != BackendKind::Cpu {
+                        return Err(bad(format!(
+                            "{x}: the backend does not run on MPI ranks yet"
+                        )));
+                    }
+                    let on = scene.as_ref().unwrap_or(&self.scene);
+                    crate::engine::choice::check(kind, &on.world, &on.step_params())
+                        .map_err(|e| bad(format!("{x}: {e}")))?;
+                    params.backend = kind;
+                }
                 _ => unreachable!("not a string variable"),
             }
         }

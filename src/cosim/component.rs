@@ -11,10 +11,12 @@ use super::pool::JoinedPool;
 use super::ranks::{Gathered, new_simulation};
 use super::variables::{Variable, variable_table};
 use crate::Real;
+use crate::engine::choice::BackendKind;
 use crate::engine::exchange::Ranks;
 use crate::output::{OutputClock, RunOutput};
 use crate::recording::Outputs;
 use crate::scene::energy_balance::EnergyBalance;
+use crate::scene::spec::SphereFrames;
 use crate::scene::{Scene, SimState, Simulation};
 use crate::world::{DriveInput, ParticleFluid, WallMotion, World};
 
@@ -132,6 +134,8 @@ pub(super) struct Parameters {
     pub(super) dt: Real,
     pub(super) output_dir: String,
     pub(super) threads: usize,
+    /// What steps the scene (default: the scene's `[simulation] backend`).
+    pub(super) backend: BackendKind,
 }
 
 /// A scene behind an FMI-style life cycle (see the [module docs](super)).
@@ -191,6 +195,7 @@ impl Component {
             dt: scene.dt,
             output_dir: String::new(),
             threads: scene.spec.simulation.threads.max(1),
+            backend: scene.backend(),
         };
         let drives = initial_drives(&scene);
         Ok(Component {
@@ -299,8 +304,8 @@ impl Component {
         }
         let pool = pool?;
         let exchange = self.ranks.as_ref().map(|r| r.another());
-        let scene = &self.scene;
-        let mut sim = pool.install(move || new_simulation(scene, exchange, None))?;
+        let (scene, backend) = (&self.scene, self.params.backend);
+        let mut sim = pool.install(move || new_simulation(scene, backend, exchange, None))?;
         sim.set_time_step(self.params.dt);
         sim.set_time(start_time);
         if let Some(start) = &self.fluid_start {
@@ -336,7 +341,10 @@ impl Component {
                     out.csv_interval,
                     self.scene.drum.as_ref(),
                 )
-                .map(|files| Outputs::writing(files, drum))
+                .map(|files| {
+                    let points = out.spheres == SphereFrames::Points;
+                    Outputs::writing(files.with_sphere_points(points), drum)
+                })
             } else {
                 let clock = OutputClock::new(out.frame_interval, out.csv_interval, sim.time());
                 Ok(Outputs::following(clock, drum))

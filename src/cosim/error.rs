@@ -59,6 +59,9 @@ pub enum CosimError {
     /// The scene cannot run on the ranks, or its state not be shared among them.
     #[error("on MPI ranks: {0}")]
     Ranks(String),
+    /// The backend asked for could not be opened (no GPU, out of device memory).
+    #[error("backend: {0}")]
+    Backend(String),
     /// Output files could not be written.
     #[error("output: {0}")]
     Output(#[from] std::io::Error),

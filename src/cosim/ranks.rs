@@ -23,6 +23,7 @@ use super::CosimError;
 use super::component::Component;
 use crate::Real;
 use crate::analysis::packing::{BedFigures, bed_figures};
+use crate::engine::choice::BackendKind;
 use crate::engine::exchange::{Exchange, Ranks, broadcast_bytes};
 use crate::scene::{Scene, ShareState, SimState, Simulation, StateReader, StateWriter};
 
@@ -102,8 +103,8 @@ impl Component {
             return Ok(sim.restore(state)?);
         }
         let exchange = self.ranks.as_ref().map(|r| r.another());
-        let scene = &self.scene;
-        let sim = pool.install(move || new_simulation(scene, exchange, Some(state)))?;
+        let (scene, backend) = (&self.scene, self.params.backend);
+        let sim = pool.install(move || new_simulation(scene, backend, exchange, Some(state)))?;
         self.sim = Some(sim);
         Ok(())
     }
@@ -149,18 +150,20 @@ impl Component {
 /// keeps its share).
 pub(super) fn new_simulation(
     scene: &Scene,
+    backend: BackendKind,
     exchange: Option<Box<dyn Ranks>>,
     state: Option<&SimState>,
 ) -> Result<Simulation, CosimError> {
-    if exchange.is_some() && scene.backend() != crate::engine::choice::BackendKind::Cpu {
+    if exchange.is_some() && backend != BackendKind::Cpu {
         return Err(CosimError::Ranks(
-            "simulation.backend: the cuda backend does not run on MPI ranks yet".into(),
+            "backend: the cuda backend does not run on MPI ranks yet".into(),
         ));
     }
+    let open = || Simulation::on(scene, backend).map_err(CosimError::Backend);
     match (exchange, state) {
-        (None, None) => Ok(Simulation::new(scene)),
+        (None, None) => open(),
         (None, Some(state)) => {
-            let mut sim = Simulation::new(scene);
+            let mut sim = open()?;
             sim.restore(state)?;
             Ok(sim)
         }

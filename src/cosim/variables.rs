@@ -59,6 +59,8 @@ pub enum Role {
     OutputDir,
     /// Worker threads.
     Threads,
+    /// The backend that steps the scene ("cpu", "cuda").
+    Backend,
     /// Particles in the world.
     Particles,
     /// Contacts at the end of the step.
@@ -202,6 +204,9 @@ pub fn variable_table(scene: &Scene) -> Vec<Variable> {
         Variable::new("threads".into(), Role::Threads, Parameter, 1)
             .typed(VarType::Integer)
             .about("Worker threads (results do not depend on it)"),
+        Variable::new("backend".into(), Role::Backend, Parameter, 1)
+            .typed(VarType::String)
+            .about("What steps the scene: cpu, or cuda (a GPU; default: the scene's [simulation] backend)"),
     ];
     for (w, wall) in scene.world.walls.iter().enumerate() {
         let n = &wall.name;

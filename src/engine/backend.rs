@@ -90,7 +90,9 @@ pub trait Backend: Send + fmt::Debug {
 
     /// Whether each particle touched another particle or a wall at the last force
     /// evaluation (frozen particles count as touching; particles added since are not
-    /// listed).
+    /// listed). A backend whose particles are not on the host
+    /// ([`particles_on_host`](Backend::particles_on_host) false) brings these up to
+    /// date with the particles, in [`sync_to_host`](Backend::sync_to_host).
     fn touching(&self) -> &[bool];
 
     /// Particles `added` were appended to the host world (state and forces set).

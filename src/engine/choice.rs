@@ -20,6 +20,30 @@ pub enum BackendKind {
     Cuda,
 }
 
+impl BackendKind {
+    /// Every backend, in the order of their names in messages.
+    pub const ALL: [BackendKind; 2] = [BackendKind::Cpu, BackendKind::Cuda];
+
+    /// Its name in a scene file, on the command line and as a parameter.
+    pub fn name(self) -> &'static str {
+        match self {
+            BackendKind::Cpu => "cpu",
+            BackendKind::Cuda => "cuda",
+        }
+    }
+}
+
+impl std::str::FromStr for BackendKind {
+    type Err = String;
+
+    fn from_str(name: &str) -> Result<Self, String> {
+        Self::ALL
+            .into_iter()
+            .find(|k| k.name() == name)
+            .ok_or_else(|| format!("'{name}': the backends are cpu and cuda"))
+    }
+}
+
 /// Whether `world` can be stepped by `backend` here: `Err` says why not (the
 /// feature not built, a scene the backend does not model, no GPU driver).
 pub fn check(backend: BackendKind, world: &World, params: &StepParams) -> Result<(), String> {

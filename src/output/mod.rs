@@ -200,6 +200,9 @@ pub struct RunOutput {
     work: Vec<Real>,
     last_frame: Option<Real>,
     drum: Option<DrumOutput>,
+    /// Whether frames write spheres as points with a radius (see
+    /// [`vtk::write_particles`]).
+    sphere_points: bool,
 }
 
 impl RunOutput {
@@ -243,7 +246,15 @@ impl RunOutput {
                 Some(d) => Some(DrumOutput::create(dir, d, world)?),
                 None => None,
             },
+            sphere_points: false,
         })
+    }
+
+    /// Frames that write spheres as points with a radius (`[output] spheres =
+    /// "points"`) rather than icospheres.
+    pub fn with_sphere_points(mut self, sphere_points: bool) -> Self {
+        self.sphere_points = sphere_points;
+        self
     }
 
     /// The output directory.
@@ -353,7 +364,7 @@ impl RunOutput {
         self.last_frame = Some(world.time);
         let p = format!("frames/particles_{k:06}.vtp");
         let w = format!("frames/walls_{k:06}.vtp");
-        vtk::write_particles(world, &self.dir.join(&p))?;
+        vtk::write_particles(world, &self.dir.join(&p), self.sphere_points)?;
         self.particles.add(world.time, p)?;
         if !world.walls.is_empty() {
             vtk::write_walls(world, &self.dir.join(&w))?;

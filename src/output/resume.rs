@@ -140,6 +140,7 @@ impl RunOutput {
                 Some(d) => Some(DrumOutput::resume(dir, d.monitor, d.csv)?),
                 None => None,
             },
+            sphere_points: false,
         })
     }
 }

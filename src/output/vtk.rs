@@ -54,50 +54,65 @@ impl Array {
     }
 }
 
-/// A polygon soup (or a point cloud: `vertices`) with per-cell fields, written as
-/// one `.vtp` piece.
+/// Cells of one kind (VTK verts or polys): each the points `connectivity` lists up
+/// to its entry in `offsets`.
+#[derive(Default)]
+struct Cells {
+    connectivity: Vec<i64>,
+    offsets: Vec<i64>,
+}
+
+impl Cells {
+    fn count(&self) -> usize {
+        self.offsets.len()
+    }
+}
+
+/// A polygon soup and a point cloud (VTK verts) with per-cell fields and per-point
+/// fields, written as one `.vtp` piece. VTK orders a piece's cells verts first, then
+/// polygons: `cell_data` lists the verts' values before the polygons'.
 #[derive(Default)]
 struct PolyData {
     points: Vec<f32>,
-    connectivity: Vec<i64>,
-    offsets: Vec<i64>,
+    verts: Cells,
+    polys: Cells,
     cell_data: Vec<Array>,
-    /// Whether the cells are single points (VTK verts) rather than polygons.
-    vertices: bool,
+    /// Per point (empty: none).
+    point_data: Vec<Array>,
 }
 
 impl PolyData {
-    fn add_polygon(&mut self, points: impl IntoIterator<Item = Point3<Real>>) {
+    fn point_count(&self) -> usize {
+        self.points.len() / 3
+    }
+
+    fn add_cell(&mut self, vertex: bool, points: impl IntoIterator<Item = Point3<Real>>) {
+        let cells = if vertex {
+            &mut self.verts
+        } else {
+            &mut self.polys
+        };
         for p in points {
-            self.connectivity.push((self.points.len() / 3) as i64);
+            cells.connectivity.push((self.points.len() / 3) as i64);
             self.points.extend(p.coords.iter().map(|&x| x as f32));
         }
-        self.offsets.push(self.connectivity.len() as i64);
+        cells.offsets.push(cells.connectivity.len() as i64);
+    }
+
+    fn add_polygon(&mut self, points: impl IntoIterator<Item = Point3<Real>>) {
+        self.add_cell(false, points);
+    }
+
+    fn add_vertex(&mut self, point: Point3<Real>) {
+        self.add_cell(true, [point]);
     }
 
     fn write(self, path: &Path) -> io::Result<()> {
-        let cells = self.offsets.len();
-        let (verts, polys, section) = if self.vertices {
-            (cells, 0, "Verts")
-        } else {
-            (0, cells, "Polys")
-        };
+        let n_points = self.point_count();
         let points = Array::F32 {
             name: "points".into(),
             components: 3,
             data: self.points,
-        };
-        let conn = Array::I64 {
-            name: "connectivity".into(),
-            data: self.connectivity,
-        };
-        let offs = Array::I64 {
-            name: "offsets".into(),
-            data: self.offsets,
-        };
-        let n_points = match &points {
-            Array::F32 { data, .. } => data.len() / 3,
-            Array::I64 { .. } => 0,
         };
         let mut blocks: Vec<Vec<u8>> = Vec::new();
         let mut xml = String::new();
@@ -113,18 +128,39 @@ impl PolyData {
             r#"<?xml version="1.0"?>
 <VTKFile type="PolyData" version="1.0" byte_order="LittleEndian" header_type="UInt64">
   <PolyData>
-    <Piece NumberOfPoints="{n_points}" NumberOfVerts="{verts}" NumberOfLines="0" NumberOfStrips="0" NumberOfPolys="{polys}">
-      <CellData>"#
+    <Piece NumberOfPoints="{n_points}" NumberOfVerts="{}" NumberOfLines="0" NumberOfStrips="0" NumberOfPolys="{}">
+      <CellData>"#,
+            self.verts.count(),
+            self.polys.count()
         );
         for a in &self.cell_data {
             header(a, &mut xml, &mut blocks);
         }
-        xml.push_str("      </CellData>\n      <Points>\n");
+        xml.push_str("      </CellData>\n      <PointData>\n");
+        for a in &self.point_data {
+            header(a, &mut xml, &mut blocks);
+        }
+        xml.push_str("      </PointData>\n      <Points>\n");
         header(&points, &mut xml, &mut blocks);
-        let _ = writeln!(xml, "      </Points>\n      <{section}>");
-        header(&conn, &mut xml, &mut blocks);
-        header(&offs, &mut xml, &mut blocks);
-        let _ = writeln!(xml, "      </{section}>\n    </Piece>\n  </PolyData>");
+        xml.push_str("      </Points>\n");
+        for (section, cells) in [("Verts", self.verts), ("Polys", self.polys)] {
+            if cells.count() == 0 {
+                continue;
+            }
+            let _ = writeln!(xml, "      <{section}>");
+            let conn = Array::I64 {
+                name: "connectivity".into(),
+                data: cells.connectivity,
+            };
+            let offs = Array::I64 {
+                name: "offsets".into(),
+                data: cells.offsets,
+            };
+            header(&conn, &mut xml, &mut blocks);
+            header(&offs, &mut xml, &mut blocks);
+            let _ = writeln!(xml, "      </{section}>");
+        }
+        xml.push_str("    </Piece>\n  </PolyData>\n");
         write_appended(path, &xml, blocks)
     }
 }
@@ -185,12 +221,9 @@ pub fn write_fluid(world: &World, path: &Path) -> io::Result<()> {
         vectors("particle_drag", &drag),
     ];
     let Some(grid) = grid.as_cartesian() else {
-        let mut cloud = PolyData {
-            vertices: true,
-            ..Default::default()
-        };
+        let mut cloud = PolyData::default();
         for c in 0..grid.len() {
-            cloud.add_polygon([grid.centre(c)]);
+            cloud.add_vertex(grid.centre(c));
         }
         cloud.cell_data.extend(arrays);
         cloud.cell_data.push(Array::F32 {
@@ -225,19 +258,39 @@ pub fn write_fluid(world: &World, path: &Path) -> io::Result<()> {
     write_appended(path, &xml, blocks)
 }
 
-/// Writes the particles of `world` as polygons to `path`.
-pub fn write_particles(world: &World, path: &Path) -> io::Result<()> {
+/// Writes the particles of `world` to `path`: polyhedra as their faces and spheres
+/// as 80-facet icospheres or, with `sphere_points`, as one point each (VTK verts,
+/// listed first) with the point field `radius` (0 on the polyhedra's points) for
+/// ParaView's Point Gaussian or Glyph: 12 bytes and a few fields a sphere where an
+/// icosphere takes about 9 kB.
+pub fn write_particles(world: &World, path: &Path, sphere_points: bool) -> io::Result<()> {
     let sphere = generators::icosphere_mesh(1, 1.0).expect("valid icosphere");
     let mut pd = PolyData::default();
     let (mut id, mut kind, mut vel, mut speed, mut omega) =
         (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
     // With a coupled fluid: each particle's drag, slip and local voidage.
     let (mut drag, mut slip, mut voidage) = (Vec::new(), Vec::new(), Vec::new());
+    let mut radius: Vec<f32> = Vec::new();
     let p = &world.particles;
-    for i in 0..p.owned() {
+    let is_point = |i: usize| {
+        sphere_points
+            && matches!(
+                world.body_types[p.body_type[i] as usize].shape,
+                Shape::Sphere(_)
+            )
+    };
+    // The points' cells first (VTK's order of verts before polygons), then the rest.
+    let order = (0..p.owned())
+        .filter(|&i| is_point(i))
+        .chain((0..p.owned()).filter(|&i| !is_point(i)));
+    for i in order {
         let t = &world.body_types[p.body_type[i] as usize];
         let pose = nalgebra::Isometry3::from_parts(p.position[i].coords.into(), p.orientation[i]);
-        let faces = match &t.shape {
+        let cells = match &t.shape {
+            Shape::Sphere(_) if sphere_points => {
+                pd.add_vertex(p.position[i]);
+                1
+            }
             Shape::Polyhedron(poly) => {
                 for f in 0..poly.face_count() {
                     pd.add_polygon(
@@ -258,8 +311,12 @@ pub fn write_particles(world: &World, path: &Path) -> io::Result<()> {
                 sphere.triangles.len()
             }
         };
+        if sphere_points {
+            let r = t.shape.as_sphere().map_or(0.0, |s| s.radius as f32);
+            radius.resize(pd.point_count(), r);
+        }
         let w = world.angular_velocity(i);
-        for _ in 0..faces {
+        for _ in 0..cells {
             id.push(p.id[i] as i64);
             kind.push(p.body_type[i] as i64);
             vel.extend(p.velocity[i].iter().map(|&x| x as f32));
@@ -268,12 +325,19 @@ pub fn write_particles(world: &World, path: &Path) -> io::Result<()> {
         }
         if let Some(fluid) = &world.fluid {
             let f = fluid.at_particle(p, i);
-            for _ in 0..faces {
+            for _ in 0..cells {
                 drag.extend(f.drag.iter().map(|&x| x as f32));
                 slip.extend(f.slip.iter().map(|&x| x as f32));
                 voidage.push(f.voidage as f32);
             }
         }
+    }
+    if sphere_points {
+        pd.point_data.push(Array::F32 {
+            name: "radius".into(),
+            components: 1,
+            data: radius,
+        });
     }
     pd.cell_data = vec![
         Array::I64 {

@@ -83,12 +83,18 @@ impl Simulation {
     /// When the scene's GPU cannot be opened after all (its kernels do not compile
     /// for it, it is out of memory).
     pub fn new(scene: &Scene) -> Self {
-        let backend = match scene.backend() {
+        Self::on(scene, scene.backend()).unwrap_or_else(|e| panic!("simulation.backend: {e}"))
+    }
+
+    /// Starts a scene at time 0 on `backend` in place of the one it asks for (the
+    /// Component's parameter `backend`); `Err` says why that backend cannot step it
+    /// here (see [`crate::engine::choice::check`]) or could not be opened.
+    pub fn on(scene: &Scene, backend: BackendKind) -> Result<Self, String> {
+        let backend: Box<dyn Backend> = match backend {
             BackendKind::Cpu => Box::new(CpuBackend::new(scene.step_params())),
-            other => crate::engine::choice::open(other, &scene.world, scene.step_params())
-                .unwrap_or_else(|e| panic!("simulation.backend: {e}")),
+            other => crate::engine::choice::open(other, &scene.world, scene.step_params())?,
         };
-        Self::with_backend(scene, backend)
+        Ok(Self::with_backend(scene, backend))
     }
 
     /// Starts a scene at time 0 on `backend`, and evaluates the first forces.

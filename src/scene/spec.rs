@@ -418,6 +418,21 @@ pub struct OutputSpec {
     /// Interval of simulated time between checkpoints of `talus run`, s (none: only
     /// `--checkpoint-every` and an interrupted run write one).
     pub checkpoint_interval: Option<Real>,
+    /// How frames draw spheres (default: icospheres).
+    #[serde(default)]
+    pub spheres: SphereFrames,
+}
+
+/// How ParaView frames draw spheres (`[output] spheres`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum SphereFrames {
+    /// 80-facet icospheres: a sphere as a surface, as polyhedra are drawn.
+    #[default]
+    Icospheres,
+    /// One point a sphere with its radius (ParaView: Point Gaussian or Glyph scaled
+    /// by `radius`): a thousandth of the bytes, for beds of millions.
+    Points,
 }
 
 /// A material (SI units).

@@ -222,3 +222,40 @@ pub fn close(a: f64, b: f64) -> bool {
 pub fn near(a: &nalgebra::Vector3<f64>, b: &nalgebra::Vector3<f64>) -> bool {
     (a - b).norm() <= 1e-12 * a.norm().max(b.norm())
 }
+
+/// The arrays of a `.vti` or `.vtp` file written with raw appended data, by name, in
+/// the file's order (Float32 and Int64 arrays, as f64).
+pub fn read_vtk(path: &Path) -> Vec<(String, Vec<f64>)> {
+    let bytes = std::fs::read(path).unwrap();
+    let marker = b"<AppendedData encoding=\"raw\">\n   _";
+    let start = bytes
+        .windows(marker.len())
+        .position(|w| w == marker)
+        .unwrap()
+        + marker.len();
+    let text = String::from_utf8_lossy(&bytes[..start]).to_string();
+    let field = |s: &str, key: &str| {
+        let s = &s[s.find(key).unwrap() + key.len()..];
+        s[..s.find('"').unwrap()].to_string()
+    };
+    text.split("<DataArray ")
+        .skip(1)
+        .map(|a| {
+            let (ty, name) = (field(a, "type=\""), field(a, "Name=\""));
+            let at = start + field(a, "offset=\"").parse::<usize>().unwrap();
+            let len = u64::from_le_bytes(bytes[at..at + 8].try_into().unwrap()) as usize;
+            let raw = &bytes[at + 8..at + 8 + len];
+            let data = match ty.as_str() {
+                "Float32" => raw
+                    .chunks(4)
+                    .map(|c| f32::from_le_bytes(c.try_into().unwrap()) as f64)
+                    .collect(),
+                _ => raw
+                    .chunks(8)
+                    .map(|c| i64::from_le_bytes(c.try_into().unwrap()) as f64)
+                    .collect(),
+            };
+            (name, data)
+        })
+        .collect()
+}

@@ -175,7 +175,7 @@ enum Command {
         ranks: bool,
         /// The backend that steps the scenes: cpu, or cuda (feature `cuda`, a GPU:
         /// the sphere scenes b and c, c under Hertz–Mindlin).
-        #[arg(long, default_value = "cpu", value_parser = backend_kind)]
+        #[arg(long, default_value = "cpu", value_parser = str::parse::<talus::engine::choice::BackendKind>)]
         backend: talus::engine::choice::BackendKind,
         /// Instead of measuring, pour the settled bed of scene (a) and write its
         /// poses to this file (about 20 minutes on two cores).
@@ -205,16 +205,6 @@ fn bench_on_ranks(_: &bench::BenchOptions) -> Result<()> {
     anyhow::bail!(
         "--ranks: this talus was built without the `mpi` feature (cargo build --features mpi)"
     )
-}
-
-/// `--backend`'s value: a backend's name as the scene's `[simulation] backend`.
-fn backend_kind(name: &str) -> Result<talus::engine::choice::BackendKind, String> {
-    use talus::engine::choice::BackendKind;
-    match name {
-        "cpu" => Ok(BackendKind::Cpu),
-        "cuda" => Ok(BackendKind::Cuda),
-        other => Err(format!("'{other}': the backends are cpu and cuda")),
-    }
 }
 
 fn main() -> Result<()> {

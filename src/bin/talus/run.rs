@@ -15,7 +15,7 @@ use talus::output::{EnergySummary, OutputClock, RunOutput, StageSummary, Summary
 use talus::recording::{Outputs, world_at_the_end};
 use talus::scene::energy_balance::EnergyBalance;
 use talus::scene::energy_ledger::EnergyReport;
-use talus::scene::spec::UpdateInterval;
+use talus::scene::spec::{SphereFrames, UpdateInterval};
 use talus::scene::{Scene, Simulation};
 
 use crate::launch::Launch;
@@ -123,6 +123,7 @@ fn run_loop(
     let frame_interval = scene.spec.output.frame_interval;
     let csv_interval = scene.spec.output.csv_interval;
     let drum = scene.drum.is_some();
+    let sphere_points = scene.spec.output.spheres == SphereFrames::Points;
     let (mut out, before) = match start {
         None => {
             let mut out = if root {
@@ -134,7 +135,7 @@ fn run_loop(
                     scene.drum.as_ref(),
                 )
                 .with_context(|| format!("cannot write to {}", dir.display()))?;
-                Outputs::writing(files, drum)
+                Outputs::writing(files.with_sphere_points(sphere_points), drum)
             } else {
                 Outputs::following(
                     OutputClock::new(frame_interval, csv_interval, sim.time()),
@@ -148,7 +149,7 @@ fn run_loop(
             let out = if root {
                 let files = RunOutput::resume(dir, frame_interval, csv_interval, c.output)
                     .with_context(|| format!("cannot take up the outputs in {}", dir.display()))?;
-                Outputs::writing(files, drum)
+                Outputs::writing(files.with_sphere_points(sphere_points), drum)
             } else {
                 Outputs::following(c.output.clock(frame_interval, csv_interval), drum)
             };

@@ -33,6 +33,8 @@ pub struct CudaBackend {
     stats: StepStats,
     times: StageTimes,
     touching: Vec<bool>,
+    /// Particles integrated (not frozen) by the stepper: fixed until it is rebuilt.
+    integrated: usize,
 }
 
 impl fmt::Debug for CudaBackend {
@@ -42,6 +44,11 @@ impl fmt::Debug for CudaBackend {
             .field("stats", &self.stats)
             .finish_non_exhaustive()
     }
+}
+
+/// The particles of `world` that are integrated (owned, not frozen).
+fn integrated(world: &World) -> usize {
+    world.particles.owned() - world.particles.frozen_count()
 }
 
 fn fail(e: impl fmt::Display) -> ! {
@@ -64,6 +71,7 @@ impl CudaBackend {
             stats: StepStats::default(),
             times: StageTimes::default(),
             touching: Vec::new(),
+            integrated: integrated(world),
         })
     }
 
@@ -77,6 +85,7 @@ impl CudaBackend {
                 spheres.set_history(&history).unwrap_or_else(|e| fail(e));
             }
             self.spheres = Some(spheres);
+            self.integrated = integrated(world);
         }
         self.spheres.as_mut().expect("a stepper")
     }
@@ -92,16 +101,24 @@ impl CudaBackend {
         }
     }
 
-    /// The host world's share of an evaluation: walls, clock, figures, touching.
+    /// The host world's share of an evaluation: walls, clock, figures (the
+    /// touching flags come with the particles, in `sync_to_host`).
     fn report_to_host(&mut self, world: &mut World) -> Result<(), DeviceError> {
         let spheres = self.spheres.as_ref().expect("a stepper");
         spheres.walls_to_host(world)?;
-        let integrated = world.particles.owned() - world.particles.frozen_count();
         self.stats = StepStats {
-            integrated,
+            integrated: self.integrated,
             ..spheres.stats()?
         };
-        self.touching = spheres.touching()?;
+        Ok(())
+    }
+
+    /// The particles and their touching flags into the host world.
+    fn particles_to_host(&mut self, world: &mut World) -> Result<(), DeviceError> {
+        if let Some(spheres) = &self.spheres {
+            spheres.particles_to_host(world)?;
+            self.touching = spheres.touching()?;
+        }
         Ok(())
     }
 }
@@ -123,7 +140,7 @@ impl Backend for CudaBackend {
     fn initialise(&mut self, world: &mut World, dt: Real) {
         let spheres = self.stepper(world);
         spheres.initialise(dt).unwrap_or_else(|e| fail(e));
-        spheres.particles_to_host(world).unwrap_or_else(|e| fail(e));
+        self.particles_to_host(world).unwrap_or_else(|e| fail(e));
         self.report_to_host(world).unwrap_or_else(|e| fail(e));
     }
 
@@ -190,9 +207,7 @@ impl Backend for CudaBackend {
     }
 
     fn sync_to_host(&mut self, world: &mut World) {
-        if let Some(spheres) = &self.spheres {
-            spheres.particles_to_host(world).unwrap_or_else(|e| fail(e));
-        }
+        self.particles_to_host(world).unwrap_or_else(|e| fail(e));
     }
 
     fn particles_on_host(&self) -> bool {

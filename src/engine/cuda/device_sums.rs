@@ -5,10 +5,10 @@
 //! every block size gives the same bits; they differ from the CPU backend's serial
 //! sums by round-off.
 //!
-//! Summed so: the contacts' elastic energy, dissipation and wall-contact count
-//! ([`sum_energies`]: the pairs' results folded into rows, one row a particle for
-//! its wall contacts), and the walls' forces, torques and facet forces
-//! (`device_walls.rs`). For a million particles with six million pairs, four
+//! Summed so: the contacts' elastic energy and dissipation and the wall and pair
+//! contact counts ([`sum_energies`]: the pairs' energy terms folded into rows, one
+//! row a particle for its wall contacts), and the walls' forces, torques and facet
+//! forces (`device_walls.rs`). For a million particles with six million pairs, four
 //! passes after the first.
 
 use super::Kernel;
@@ -18,8 +18,8 @@ use super::device_walls::DeviceWalls;
 use crate::Real;
 
 /// Doubles of a row of the energy sums: elastic energy, dissipated energy, wall
-/// contacts (`ENERGY_RECORD` in `kernels/contact.cuh`).
-const ENERGY_RECORD: usize = 3;
+/// contacts, pair contacts (`ENERGY_RECORD` in `kernels/contact.cuh`).
+const ENERGY_RECORD: usize = 4;
 
 /// The rows a thread of a pass folds into one, at most.
 const FAN_IN: usize = 32;
@@ -103,31 +103,39 @@ impl RowSums {
     }
 }
 
-/// Sums the elastic energy and dissipation in the `pairs` pairs' `results`, and in
-/// the wall contacts of `walls` for `n` particles, into `totals` (elastic energy,
-/// dissipated energy, wall contacts), by the scratch `sums`.
+/// The candidate pairs' share of the energy sums: their energy terms (`spheres.cu`)
+/// and whether each touches.
+pub(super) struct PairTerms<'a> {
+    pub count: usize,
+    pub terms: &'a Array<Real>,
+    pub touching: &'a Array<u8>,
+}
+
+/// Sums the elastic energy and dissipation of the `pairs` and of the wall contacts
+/// of `walls` for `n` particles into `totals` (elastic energy, dissipated energy,
+/// wall contacts, pair contacts), by the scratch `sums`.
 pub(super) fn sum_energies(
     sums: &mut RowSums,
     device: &mut dyn Device,
-    pairs: usize,
-    results: &Array<Real>,
+    pairs: &PairTerms,
     walls: &DeviceWalls,
     n: usize,
     totals: &mut Array<Real>,
 ) -> Result<(), DeviceError> {
-    let first = first_rows(pairs);
+    let first = first_rows(pairs.count);
     let wall_rows = if walls.is_empty() { 0 } else { n };
     let rows = sums.rows(device, first + wall_rows, ENERGY_RECORD)?;
-    // SAFETY: the parameters of pair_energy_partials (sums.cu): `results` holds
-    // `pairs` results, `rows` room for the `first` rows written.
+    // SAFETY: the parameters of pair_energy_partials (sums.cu): `terms` and
+    // `touching` hold the pairs', `rows` room for the `first` rows written.
     unsafe {
         run(
             device,
             Kernel::PairEnergyPartials,
             first,
             &[
-                Arg::U32(pairs as u32),
-                results.arg(),
+                Arg::U32(pairs.count as u32),
+                pairs.terms.arg(),
+                pairs.touching.arg(),
                 Arg::U32(first as u32),
                 rows.arg(),
             ],

@@ -56,7 +56,9 @@ impl CudaDevice {
         let mut functions = HashMap::new();
         for file in &FILES {
             let ptx = super::nvrtc::compile(file, &arch)?;
-            let module = context.load_module(Ptx::from_src(ptx)).map_err(driver)?;
+            let module = context
+                .load_module(Ptx::from_src(ptx.to_string()))
+                .map_err(driver)?;
             for kernel in Kernel::ALL
                 .into_iter()
                 .filter(|k| k.file().name == file.name)

@@ -126,8 +126,6 @@ pub enum Kernel {
     SphereContacts,
     /// Each particle's weight and pair forces (`spheres.cu`).
     GatherForces,
-    /// The pairs that touch, counted (`spheres.cu`).
-    CountTouching,
     /// The Hertz–Mindlin contacts of spheres with wall facets (`walls.cu`).
     SphereWalls,
     /// The walls' forces, torques and facet forces, first pass (`walls.cu`).
@@ -142,7 +140,7 @@ pub enum Kernel {
 
 impl Kernel {
     /// Every kernel.
-    pub const ALL: [Kernel; 26] = [
+    pub const ALL: [Kernel; 25] = [
         Kernel::KickDrift,
         Kernel::ClosingKick,
         Kernel::BinParticles,
@@ -163,7 +161,6 @@ impl Kernel {
         Kernel::CopyWords,
         Kernel::SphereContacts,
         Kernel::GatherForces,
-        Kernel::CountTouching,
         Kernel::SphereWalls,
         Kernel::WallSumRows,
         Kernel::WallEnergyTerms,
@@ -194,7 +191,6 @@ impl Kernel {
             Kernel::CopyWords => "copy_words",
             Kernel::SphereContacts => "sphere_contacts",
             Kernel::GatherForces => "gather_forces",
-            Kernel::CountTouching => "count_touching",
             Kernel::SphereWalls => "sphere_walls",
             Kernel::WallSumRows => "wall_sum_rows",
             Kernel::WallEnergyTerms => "wall_energy_terms",
@@ -213,7 +209,7 @@ impl Kernel {
                 1
             }
             ScanChunkTotals | ScanChunkOffsets | ScanApply | ZeroWords | CopyWords => 2,
-            SphereContacts | GatherForces | CountTouching => 3,
+            SphereContacts | GatherForces => 3,
             SphereWalls | WallSumRows | WallEnergyTerms => 4,
             PairEnergyPartials | SumRecords => 5,
         };

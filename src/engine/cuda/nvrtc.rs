@@ -2,6 +2,9 @@
 //! `libnvrtc` at run time (the CUDA toolkit's, or PyPI's `nvidia-cuda-nvrtc-cu12`
 //! with its `lib` directory on `LD_LIBRARY_PATH`).
 
+use std::collections::HashMap;
+use std::sync::{Arc, Mutex, MutexGuard, OnceLock};
+
 use super::KernelFile;
 
 /// The GPU architectures every kernel is compiled for: Ampere (A100) and Hopper
@@ -35,8 +38,45 @@ pub fn is_present() -> bool {
     unsafe { cudarc::nvrtc::sys::is_culib_present() }
 }
 
-/// The kernel file compiled to PTX for `arch` (`"sm_80"`, `"sm_90"`, ...).
-pub fn compile(file: &KernelFile, arch: &str) -> Result<String, NvrtcError> {
+/// PTX of each kernel file and architecture compiled in this process, with how
+/// many times each was compiled.
+type Cache = HashMap<(&'static str, String), (Arc<str>, usize)>;
+
+fn cache() -> MutexGuard<'static, Cache> {
+    static CACHE: OnceLock<Mutex<Cache>> = OnceLock::new();
+    let cache = CACHE.get_or_init(Mutex::default);
+    // A panic while the lock was held left the map whole: every insertion is one call.
+    cache
+        .lock()
+        .unwrap_or_else(|poisoned| poisoned.into_inner())
+}
+
+/// The kernel file compiled to PTX for `arch` (`"sm_80"`, `"sm_90"`, ...), once per
+/// process: a device opened again (a component reset, a second simulation) takes
+/// the PTX of the first compilation.
+pub fn compile(file: &KernelFile, arch: &str) -> Result<Arc<str>, NvrtcError> {
+    let key = (file.name, arch.to_owned());
+    if let Some((ptx, _)) = cache().get(&key) {
+        return Ok(ptx.clone());
+    }
+    // Compiled without the lock: files compile in parallel, and two threads asking for
+    // the same one at once both compile it (the same text).
+    let ptx: Arc<str> = compile_uncached(file, arch)?.into();
+    let mut cache = cache();
+    let entry = cache.entry(key).or_insert_with(|| (ptx, 0));
+    entry.1 += 1;
+    Ok(entry.0.clone())
+}
+
+/// How many times this process compiled `file` for `arch` (see [`compile`]).
+pub fn compilations(file: &KernelFile, arch: &str) -> usize {
+    cache()
+        .get(&(file.name, arch.to_owned()))
+        .map_or(0, |(_, count)| *count)
+}
+
+/// The kernel file compiled to PTX for `arch`, without the cache.
+fn compile_uncached(file: &KernelFile, arch: &str) -> Result<String, NvrtcError> {
     let headers: String = file
         .headers
         .iter()

@@ -24,7 +24,7 @@ mod transfer;
 use super::Kernel;
 use super::device::{Arg, Array, Device, DeviceError};
 use super::device_list::{DeviceList, ListInputs, run};
-use super::device_sums::{RowSums, sum_energies};
+use super::device_sums::{PairTerms, RowSums, sum_energies};
 use super::device_walls::{DeviceWalls, WallInputs};
 use crate::Real;
 use crate::contact::{RollingModel, pair_restitution};
@@ -36,7 +36,9 @@ use crate::world::World;
 /// stiffness it was stretched at.
 const HISTORY: usize = 4;
 /// Doubles of a pair's result (`kernels/spheres.cu`).
-const RESULT: usize = 11;
+const RESULT: usize = 9;
+/// Doubles of a pair's energy terms (`kernels/spheres.cu`).
+const PAIR_ENERGY: usize = 2;
 
 /// Why a world cannot be stepped on the device.
 #[derive(Debug, thiserror::Error)]
@@ -85,9 +87,11 @@ struct PairArrays {
     history: Array<Real>,
     old_history: Array<Real>,
     results: Array<Real>,
+    /// Each pair's elastic energy and dissipation.
+    terms: Array<Real>,
     touching: Array<u8>,
-    counter: Array<u32>,
-    /// The contacts' elastic energy and dissipation of the last evaluation.
+    /// The sums of the last evaluation: the contacts' elastic energy and
+    /// dissipation, the wall contacts and the pair contacts.
     energies: Array<Real>,
 }
 
@@ -105,8 +109,6 @@ pub struct DeviceSpheres {
     walls: DeviceWalls,
     /// Scratch of the energy sums.
     sums: RowSums,
-    /// Pairs that touched at the last force evaluation.
-    contacts: usize,
 }
 
 fn flat<const K: usize, T: Copy>(items: impl Iterator<Item = [T; K]>) -> Vec<T> {
@@ -189,7 +191,6 @@ impl DeviceSpheres {
             list,
             walls,
             sums: RowSums::default(),
-            contacts: 0,
         };
         spheres.upload_particles(world)?;
         Ok(spheres)
@@ -253,9 +254,9 @@ impl DeviceSpheres {
         self.device.description()
     }
 
-    /// Pairs that touched at the last force evaluation.
-    pub fn contacts(&self) -> usize {
-        self.contacts
+    /// Pairs that touched at the last force evaluation (read from the device).
+    pub fn contacts(&self) -> Result<usize, DeviceError> {
+        Ok(self.stats()?.pair_contacts)
     }
 
     /// Candidate pairs of the list.
@@ -371,15 +372,13 @@ impl DeviceSpheres {
                 )?;
             }
             pairs.results.resize(d, RESULT * list.pair_count)?;
+            pairs.terms.resize(d, PAIR_ENERGY * list.pair_count)?;
             pairs.touching.resize(d, list.pair_count)?;
         }
         let count = list.pair_count;
-        pairs.counter.resize(d, 1)?;
-        // SAFETY: the parameters of sphere_contacts, gather_forces and
-        // count_touching (spheres.cu), every array sized for its pairs, particles or
-        // body types.
+        // SAFETY: the parameters of sphere_contacts and gather_forces (spheres.cu),
+        // every array sized for its pairs, particles or body types.
         unsafe {
-            run(d, Kernel::ZeroWords, 1, &[Arg::U32(1), pairs.counter.arg()])?;
             run(
                 d,
                 Kernel::SphereContacts,
@@ -401,6 +400,7 @@ impl DeviceSpheres {
                     t.material_pairs.arg(),
                     pairs.history.arg(),
                     pairs.results.arg(),
+                    pairs.terms.arg(),
                     pairs.touching.arg(),
                 ],
             )?;
@@ -426,18 +426,7 @@ impl DeviceSpheres {
                     p.touching.arg(),
                 ],
             )?;
-            run(
-                d,
-                Kernel::CountTouching,
-                count,
-                &[
-                    Arg::U32(count as u32),
-                    pairs.touching.arg(),
-                    pairs.counter.arg(),
-                ],
-            )?;
         }
-        self.contacts = pairs.counter.get(d, 0)? as usize;
         if !self.walls.is_empty() {
             let at = WallInputs {
                 n: self.n,
@@ -460,11 +449,15 @@ impl DeviceSpheres {
             };
             self.walls.contacts(d, &at)?;
         }
+        let terms = PairTerms {
+            count,
+            terms: &pairs.terms,
+            touching: &pairs.touching,
+        };
         sum_energies(
             &mut self.sums,
             d,
-            count,
-            &pairs.results,
+            &terms,
             &self.walls,
             self.n,
             &mut pairs.energies,

@@ -34,11 +34,12 @@ impl DeviceSpheres {
             &q.history,
             &q.old_history,
             &q.results,
+            &q.terms,
         ];
         let bytes = [&p.frozen, &p.touching, &q.touching];
         doubles.iter().map(|a| a.bytes(d)).sum::<usize>()
             + bytes.iter().map(|a| a.bytes(d)).sum::<usize>()
-            + [&p.body_type, &t.material, &q.counter]
+            + [&p.body_type, &t.material]
                 .iter()
                 .map(|a| a.bytes(d))
                 .sum::<usize>()
@@ -59,12 +60,13 @@ impl DeviceSpheres {
 
     /// The figures of the last force evaluation: contacts (pairs and walls), the
     /// pairs', candidate pairs, elastic energy and dissipation, list builds (one
-    /// read of three numbers from the device).
+    /// read of four numbers from the device).
     pub fn stats(&self) -> Result<crate::engine::StepStats, DeviceError> {
         let e = self.pairs.energies.read(self.device.as_ref())?;
+        let pair_contacts = e[3] as usize;
         Ok(crate::engine::StepStats {
-            contacts: self.contacts + e[2] as usize,
-            pair_contacts: self.contacts,
+            contacts: pair_contacts + e[2] as usize,
+            pair_contacts,
             candidate_pairs: self.list.pair_count,
             integrated: 0,
             elastic_energy: e[0],
