@@ -136,11 +136,16 @@ impl PolyData {
         for a in &self.cell_data {
             header(a, &mut xml, &mut blocks);
         }
-        xml.push_str("      </CellData>\n      <PointData>\n");
-        for a in &self.point_data {
-            header(a, &mut xml, &mut blocks);
+        xml.push_str("      </CellData>\n");
+        // Only where there are point fields: the frames without are as they were.
+        if !self.point_data.is_empty() {
+            xml.push_str("      <PointData>\n");
+            for a in &self.point_data {
+                header(a, &mut xml, &mut blocks);
+            }
+            xml.push_str("      </PointData>\n");
         }
-        xml.push_str("      </PointData>\n      <Points>\n");
+        xml.push_str("      <Points>\n");
         header(&points, &mut xml, &mut blocks);
         xml.push_str("      </Points>\n");
         for (section, cells) in [("Verts", self.verts), ("Polys", self.polys)] {
