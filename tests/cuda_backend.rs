@@ -12,6 +12,7 @@ use common::{close, near};
 
 use talus::engine::cuda::backend::CudaBackend;
 use talus::engine::cuda::device::HostDevice;
+use talus::engine::{Backend, CpuBackend};
 use talus::scene::{Scene, Simulation};
 
 const POUR: &str = r#"
@@ -286,4 +287,100 @@ fn the_component_parameter_backend_chooses_what_steps_the_scene() {
         }
     }
     assert!(cpu.world().particles.len() > 100);
+}
+
+/// What the host changes between steps is uploaded alone, as the seam's sync points
+/// call it: particles frozen, velocities set and particles appended (an inlet's)
+/// go to the device without the stepper being made again from the whole world
+/// (`CudaBackend::rebuilds`), and the run stays the CPU backend's to the bit; a
+/// removal rebuilds it.
+#[test]
+fn changes_on_the_host_are_uploaded_alone_and_keep_the_bits() {
+    let scene = Scene::parse(POUR, Path::new("pour.toml")).unwrap();
+    let dt = scene.dt;
+    let mut cpu = CpuBackend::new(scene.step_params());
+    let device = Box::new(HostDevice::new(64));
+    let mut gpu = CudaBackend::new(device, &scene.world, scene.step_params()).unwrap();
+    let (mut a, mut b) = (scene.world.clone(), scene.world.clone());
+    cpu.world_changed(&a);
+    cpu.initialise(&mut a, dt);
+    gpu.initialise(&mut b, dt);
+    let compare = |cpu: &mut CpuBackend, gpu: &mut CudaBackend, a: &mut _, b: &mut _| {
+        for step in 0..200 {
+            cpu.step(a, dt);
+            gpu.step(b, dt);
+            if step % 50 == 49 {
+                gpu.sync_to_host(b);
+                let (p, q) = (&a.particles, &b.particles);
+                assert_eq!(p.position, q.position, "step {step}");
+                assert_eq!(p.velocity, q.velocity, "step {step}");
+                assert_eq!(p.angular_momentum, q.angular_momentum, "step {step}");
+                assert_eq!(cpu.touching(), gpu.touching(), "step {step}");
+                assert_eq!(cpu.stats().contacts, gpu.stats().contacts, "step {step}");
+                assert!(near(&a.walls[0].force, &b.walls[0].force), "step {step}");
+            }
+        }
+    };
+    compare(&mut cpu, &mut gpu, &mut a, &mut b);
+    let n = a.particles.len();
+    assert!(n > 40 && cpu.stats().contacts > 20, "{n} {:?}", cpu.stats());
+
+    // Every fifth particle frozen where it is.
+    let frozen: Vec<usize> = (0..n).step_by(5).collect();
+    for w in [&mut a, &mut b] {
+        for &i in &frozen {
+            w.particles.freeze(i);
+        }
+    }
+    cpu.particles_frozen(&a, &frozen);
+    gpu.particles_frozen(&b, &frozen);
+    compare(&mut cpu, &mut gpu, &mut a, &mut b);
+
+    // The others thrown upward.
+    for w in [&mut a, &mut b] {
+        for i in (0..n).filter(|i| i % 5 != 0) {
+            w.particles.velocity[i].z += 0.3;
+        }
+    }
+    cpu.velocities_set(&a);
+    gpu.velocities_set(&b);
+    compare(&mut cpu, &mut gpu, &mut a, &mut b);
+
+    // Particles appended above the bed, as an inlet does (state and weight set),
+    // more than the buffers' room to grow, then a few that fit.
+    let mut added = 0;
+    for count in [n, 3] {
+        for w in [&mut a, &mut b] {
+            let p = &mut w.particles;
+            for k in 0..count {
+                let at = nalgebra::Point3::new(
+                    0.006 + 0.009 * (k % 5) as f64,
+                    0.006 + 0.009 * (k / 5 % 5) as f64,
+                    0.08 + 0.009 * (k / 25) as f64,
+                );
+                let id = 10_000 + (added + k) as u64;
+                p.push(0, at, nalgebra::UnitQuaternion::identity(), id);
+                let i = p.len() - 1;
+                p.velocity[i] = nalgebra::Vector3::new(0.0, 0.0, -0.5);
+            }
+            let len = w.particles.len();
+            w.weigh(len - count..len);
+        }
+        let range = a.particles.len() - count..a.particles.len();
+        cpu.particles_added(&a, range.clone());
+        gpu.particles_added(&b, range);
+        added += count;
+        compare(&mut cpu, &mut gpu, &mut a, &mut b);
+    }
+    assert_eq!(a.particles.len(), 2 * n + 3);
+    assert_eq!(gpu.rebuilds(), 0, "only what changed was uploaded");
+
+    // A removal takes the whole world again.
+    for (w, backend) in [(&mut a, &mut cpu as &mut dyn Backend), (&mut b, &mut gpu)] {
+        backend.sync_to_host(w);
+        w.particles.remove_where(|i| i % 7 == 3);
+        backend.particles_removed(w);
+    }
+    compare(&mut cpu, &mut gpu, &mut a, &mut b);
+    assert_eq!(gpu.rebuilds(), 1);
 }

@@ -519,7 +519,15 @@ fn print_row(name: &str, threads: usize, m: &Measured, dt: f64, error: &str) {
         m.contact_rate,
         error
     );
-    println!("{:<38} stages: {}", "", stage_line(&m.stages));
+    if m.stages.iter().any(|&(_, share)| share > 0.0) {
+        println!("{:<38} stages: {}", "", stage_line(&m.stages));
+    } else {
+        println!(
+            "{:<38} stages: not timed apart by this backend (a GPU's launches return \
+             before their kernels finish)",
+            ""
+        );
+    }
 }
 
 /// Stage shares as `name 12.3 %, ...`.

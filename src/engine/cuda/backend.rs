@@ -3,11 +3,12 @@
 //!
 //! The device holds the particles between steps; after each step the host world
 //! gets the walls' poses, forces and facet forces, the clock, the touching flags and
-//! the step's figures (a few numbers and one byte a particle), and the particles
-//! when it asks (`sync_to_host`). A change the host makes to its world (particles
-//! added, frozen, removed, velocities set, anything else) rebuilds the stepper from
-//! the host world at the next evaluation, the contact history carried over; walls
-//! moved from outside are taken as they are.
+//! the step's figures (a few numbers), and the particles with their touching flags
+//! when it asks (`sync_to_host`). What the host changes in its world is uploaded
+//! alone where it can be: particles added by an inlet are appended, frozen flags
+//! and velocities set are uploaded, walls moved from outside are placed; particles
+//! removed or anything else rebuild the stepper from the host world at the next
+//! evaluation, the contact history carried over.
 //!
 //! A device call that fails (a lost GPU, a sphere at more than four walls) panics:
 //! the seam's calls are infallible, and a backend that lost its state cannot go on.
@@ -19,7 +20,7 @@ use super::spheres::{DeviceSpheres, SpheresError};
 use crate::Real;
 use crate::engine::backend::{Backend, ContactHistory};
 use crate::engine::params::StepParams;
-use crate::engine::stats::{Stage, StageTimes, StepStats};
+use crate::engine::stats::{StageTimes, StepStats};
 use crate::world::World;
 
 /// The CUDA backend (see the module).
@@ -31,10 +32,13 @@ pub struct CudaBackend {
     /// The history to set on the next stepper (a restore, or the one replaced).
     history: Option<ContactHistory>,
     stats: StepStats,
+    /// Zero: a device's stages are not timed (see `step`).
     times: StageTimes,
     touching: Vec<bool>,
-    /// Particles integrated (not frozen) by the stepper: fixed until it is rebuilt.
+    /// Particles integrated (not frozen) by the stepper.
     integrated: usize,
+    /// Steppers made again from the whole host world since the first.
+    rebuilds: u64,
 }
 
 impl fmt::Debug for CudaBackend {
@@ -72,7 +76,15 @@ impl CudaBackend {
             times: StageTimes::default(),
             touching: Vec::new(),
             integrated: integrated(world),
+            rebuilds: 0,
         })
+    }
+
+    /// How many times the stepper was made again from the whole host world (a change
+    /// the backend does not upload alone: particles removed, parameters or the
+    /// world changed, a state restored).
+    pub fn rebuilds(&self) -> u64 {
+        self.rebuilds
     }
 
     /// The stepper, rebuilt from `world` if the host changed it.
@@ -86,8 +98,17 @@ impl CudaBackend {
             }
             self.spheres = Some(spheres);
             self.integrated = integrated(world);
+            self.rebuilds += 1;
         }
         self.spheres.as_mut().expect("a stepper")
+    }
+
+    /// Frozen flags and velocities changed on the host: uploaded.
+    fn motion_from_host(&mut self, world: &World) {
+        if let Some(spheres) = self.spheres.as_mut() {
+            spheres.motion_from_host(world).unwrap_or_else(|e| fail(e));
+            self.integrated = integrated(world);
+        }
     }
 
     /// Drops the stepper (its history kept): the next evaluation rebuilds it from
@@ -144,13 +165,12 @@ impl Backend for CudaBackend {
         self.report_to_host(world).unwrap_or_else(|e| fail(e));
     }
 
-    /// One step on the device (its stages timed together as pair contacts: the
-    /// launches of a GPU return before they finish).
+    /// One step on the device. Its stages are not timed (the stage times stay
+    /// zero): the launches of a GPU return before their kernels finish, so a host
+    /// clock would give each stage the wait of the next read instead.
     fn step(&mut self, world: &mut World, dt: Real) {
-        let start = std::time::Instant::now();
         self.stepper(world).step(dt).unwrap_or_else(|e| fail(e));
         self.report_to_host(world).unwrap_or_else(|e| fail(e));
-        self.times.add(Stage::PairContacts, start.elapsed());
     }
 
     fn stats(&self) -> &StepStats {
@@ -165,20 +185,28 @@ impl Backend for CudaBackend {
         &self.touching
     }
 
-    fn particles_added(&mut self, _world: &World, _added: std::ops::Range<usize>) {
-        self.rebuild();
+    /// Appended to the device's particles (an inlet's, after every other).
+    fn particles_added(&mut self, world: &World, added: std::ops::Range<usize>) {
+        let appended = added.end == world.particles.len() && world.particles.id.is_sorted();
+        match self.spheres.as_mut() {
+            Some(spheres) if appended && spheres.particles() == added.start => {
+                spheres.append(world).unwrap_or_else(|e| fail(e));
+                self.integrated = integrated(world);
+            }
+            _ => self.rebuild(),
+        }
     }
 
-    fn particles_frozen(&mut self, _world: &World, _frozen: &[usize]) {
-        self.rebuild();
+    fn particles_frozen(&mut self, world: &World, _frozen: &[usize]) {
+        self.motion_from_host(world);
     }
 
     fn particles_removed(&mut self, _world: &World) {
         self.rebuild();
     }
 
-    fn velocities_set(&mut self, _world: &World) {
-        self.rebuild();
+    fn velocities_set(&mut self, world: &World) {
+        self.motion_from_host(world);
     }
 
     fn walls_moved(&mut self, world: &World) {

@@ -265,6 +265,36 @@ impl<T: Pod> Array<T> {
         Ok(())
     }
 
+    /// Appends `tail` after the elements when the buffer has room for them, and says
+    /// whether it had (when not, the array is as it was).
+    pub fn append(&mut self, device: &mut dyn Device, tail: &[T]) -> Result<bool, DeviceError> {
+        let len = self.len + tail.len();
+        let fits = self
+            .buffer
+            .is_some_and(|b| device.size(b) >= len.max(1) * size_of::<T>());
+        if !fits {
+            return Ok(false);
+        }
+        let first = self.len;
+        self.len = len;
+        self.write_at(device, first, tail)?;
+        Ok(true)
+    }
+
+    /// Grows the array to `len` elements (at least its length), keeping its
+    /// elements and zeroing the new ones; a buffer without room is replaced, the
+    /// elements copied through the host.
+    pub fn grow_zeroed(&mut self, device: &mut dyn Device, len: usize) -> Result<(), DeviceError> {
+        let added = len.saturating_sub(self.len);
+        if self.append(device, &vec![T::zeroed(); added])? {
+            return Ok(());
+        }
+        let kept = self.read(device)?;
+        // A new buffer (it had no room): zeroed.
+        self.resize(device, len)?;
+        self.write_at(device, 0, &kept)
+    }
+
     /// Resizes to `data.len()` and copies `data` in.
     pub fn write(&mut self, device: &mut dyn Device, data: &[T]) -> Result<(), DeviceError> {
         self.resize(device, data.len())?;

@@ -141,6 +141,24 @@ impl DeviceWalls {
         Ok(walls)
     }
 
+    /// Makes room for `n` particles, the first of them already here keeping their
+    /// wall contacts and springs, the new ones without any.
+    pub fn grow(&mut self, device: &mut dyn Device, n: usize) -> Result<(), DeviceError> {
+        if self.is_empty() {
+            return Ok(());
+        }
+        // The last evaluation's slots are the next one's history; the others are
+        // written whole by every evaluation.
+        self.new.count.grow_zeroed(device, n)?;
+        self.new.keys.grow_zeroed(device, KEY * SLOTS * n)?;
+        self.new.springs.grow_zeroed(device, SPRING * SLOTS * n)?;
+        self.old.count.resize(device, n)?;
+        self.old.keys.resize(device, KEY * SLOTS * n)?;
+        self.old.springs.resize(device, SPRING * SLOTS * n)?;
+        self.records.resize(device, RECORD * SLOTS * n)?;
+        self.record_facet.resize(device, SLOTS * n)
+    }
+
     /// Bytes of device memory the walls hold: their facets and, per particle,
     /// [`SLOTS`] contacts (two sets of keys and springs, and the records).
     pub fn bytes(&self, device: &dyn Device) -> usize {

@@ -259,6 +259,11 @@ impl DeviceSpheres {
         Ok(self.stats()?.pair_contacts)
     }
 
+    /// Particles on the device.
+    pub fn particles(&self) -> usize {
+        self.n
+    }
+
     /// Candidate pairs of the list.
     pub fn candidate_pairs(&self) -> usize {
         self.list.pair_count

@@ -4,7 +4,7 @@
 
 use nalgebra::{Point3, Quaternion, UnitQuaternion, Vector3};
 
-use super::{DeviceSpheres, HISTORY};
+use super::{DeviceSpheres, HISTORY, flat, vectors};
 use crate::Real;
 use crate::contact::TangentialHistory;
 use crate::engine::backend::ContactHistory;
@@ -100,6 +100,52 @@ impl DeviceSpheres {
         self.pairs.old_history.write(d, &springs)?;
         let ids = self.particles.id.read(d)?;
         self.walls.set_history(d, &ids, &history.walls)
+    }
+
+    /// Takes the particles appended to `world` since the stepper saw it last (an
+    /// inlet's: their ids above every other, the host world up to date): their
+    /// state goes after the others' (the arrays uploaded whole only where a buffer
+    /// has no room left), they start without wall contacts, and the list is built
+    /// again at the next evaluation, the pairs' history carried by their ids.
+    pub fn append(&mut self, world: &World) -> Result<(), DeviceError> {
+        let p = &world.particles;
+        let (from, n) = (self.n, p.len());
+        let (d, a) = (self.device.as_mut(), &mut self.particles);
+        grow(d, &mut a.position, from, n, |r| {
+            flat(p.position[r].iter().map(|x| [x.x, x.y, x.z]))
+        })?;
+        grow(d, &mut a.velocity, from, n, |r| vectors(&p.velocity[r]))?;
+        grow(d, &mut a.orientation, from, n, |r| {
+            flat(p.orientation[r].iter().map(|q| q.coords.into()))
+        })?;
+        grow(d, &mut a.angular_momentum, from, n, |r| {
+            vectors(&p.angular_momentum[r])
+        })?;
+        grow(d, &mut a.force, from, n, |r| vectors(&p.force[r]))?;
+        grow(d, &mut a.torque, from, n, |r| vectors(&p.torque[r]))?;
+        grow(d, &mut a.body_type, from, n, |r| p.body_type[r].to_vec())?;
+        grow(d, &mut a.frozen, from, n, |r| {
+            p.frozen[r].iter().map(|&f| u8::from(f)).collect()
+        })?;
+        grow(d, &mut a.id, from, n, |r| p.id[r].to_vec())?;
+        a.touching.resize(d, n)?;
+        self.walls.grow(d, n)?;
+        self.n = n;
+        self.list.invalidate();
+        Ok(())
+    }
+
+    /// Takes the particles' frozen flags, velocities and angular momenta from
+    /// `world` (some frozen, or their velocities set, on the host); the list
+    /// stays (pairs of frozen particles drop out of the contacts, not the list).
+    pub fn motion_from_host(&mut self, world: &World) -> Result<(), DeviceError> {
+        let (d, a, p) = (self.device.as_mut(), &mut self.particles, &world.particles);
+        a.frozen.write(
+            d,
+            &p.frozen.iter().map(|&f| u8::from(f)).collect::<Vec<_>>(),
+        )?;
+        a.velocity.write(d, &vectors(&p.velocity))?;
+        a.angular_momentum.write(d, &vectors(&p.angular_momentum))
     }
 
     /// Takes the walls' poses, velocities and motions from `world` (moved by the
@@ -199,4 +245,20 @@ impl DeviceSpheres {
             .collect();
         Ok(ContactHistory { pairs, walls })
     }
+}
+
+/// Grows `array` from the values of particles `..from` to those of `..n`, given by
+/// `values` for a range of particles: the new particles' appended where the buffer
+/// has room, all of them uploaded again where not.
+fn grow<T: bytemuck::Pod>(
+    device: &mut dyn Device,
+    array: &mut Array<T>,
+    from: usize,
+    n: usize,
+    values: impl Fn(std::ops::Range<usize>) -> Vec<T>,
+) -> Result<(), DeviceError> {
+    if !array.append(device, &values(from..n))? {
+        array.write(device, &values(0..n))?;
+    }
+    Ok(())
 }
