@@ -25,15 +25,16 @@ static __device__ __forceinline__ double strided_sum(const double* at, size_t en
     return (a0 + a1) + (a2 + a3);
 }
 
+// The records are written from double `offset` of `out`.
 extern "C" __global__ void sum_records(unsigned count, unsigned width, const double* in,
-                                       unsigned groups, double* out) {
+                                       unsigned groups, double* out, unsigned offset) {
     unsigned g = blockIdx.x * blockDim.x + threadIdx.x;
     if (g >= groups * width) {
         return;
     }
     unsigned t = g / width, c = g % width;
     size_t first = (size_t)width * t + c;
-    out[first] = count > t ? strided_sum(in + first, (size_t)width * (count - t),
+    out[offset + first] = count > t ? strided_sum(in + first, (size_t)width * (count - t),
                                          (size_t)width * groups)
                            : 0.0;
 }

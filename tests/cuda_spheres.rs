@@ -441,3 +441,37 @@ fn walls_polyhedra_and_other_laws_are_refused() {
             .ends_with("particles out of the order of their ids")
     );
 }
+
+/// A sphere wedged in a box narrower than itself touches its floor and four sides:
+/// one contact more than the four slots a sphere has for walls, which the step
+/// reports as an error (read back with the step's sums) instead of dropping it.
+#[test]
+fn a_sphere_at_more_walls_than_its_slots_is_an_error() {
+    let walls = r#"
+[[wall]]
+name = "box"
+material = "glass"
+geometry = { kind = "box", min = [-0.0039, -0.0039, 0.0], max = [0.0039, 0.0039, 0.02], open_top = true }
+"#;
+    let scene = Scene::parse(&format!("{SCENE}{walls}"), Path::new("wedged.toml")).unwrap();
+    let params = scene.step_params();
+    let mut world = scene.world;
+    world.particles = Default::default();
+    world.particles.push(
+        1,
+        Point3::new(0.0, 0.0, 0.0039),
+        UnitQuaternion::identity(),
+        0,
+    );
+    let mut spheres = DeviceSpheres::new(host(64), &world, &params).unwrap();
+    let e = spheres.initialise(2e-5).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "the device stepper holds no sphere touching walls at more than 4 places at once"
+    );
+    // Four places are within the slots.
+    world.particles.position[0].x = 0.0005;
+    let mut spheres = DeviceSpheres::new(host(64), &world, &params).unwrap();
+    spheres.initialise(2e-5).unwrap();
+    assert_eq!(spheres.stats().unwrap().contacts, 4);
+}

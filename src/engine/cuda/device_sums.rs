@@ -15,11 +15,12 @@ use super::Kernel;
 use super::device::{Arg, Array, Device, DeviceError};
 use super::device_list::run;
 use super::device_walls::DeviceWalls;
+use super::readback::{self, Readback};
 use crate::Real;
 
 /// Doubles of a row of the energy sums: elastic energy, dissipated energy, wall
 /// contacts, pair contacts (`ENERGY_RECORD` in `kernels/contact.cuh`).
-const ENERGY_RECORD: usize = 4;
+pub(super) const ENERGY_RECORD: usize = 4;
 
 /// The rows a thread of a pass folds into one, at most.
 const FAN_IN: usize = 32;
@@ -66,18 +67,24 @@ impl RowSums {
     }
 
     /// Folds the `rows` rows of `width` doubles written into [`rows`](Self::rows)
-    /// into one, written to `out` (`width` doubles).
+    /// into one, written to `out` from double `at` (`out` holds `at + width`).
     pub fn fold(
         &mut self,
         device: &mut dyn Device,
         mut rows: usize,
         width: usize,
-        out: &mut Array<Real>,
+        out: &Array<Real>,
+        at: usize,
     ) -> Result<(), DeviceError> {
-        out.resize(device, width)?;
+        if out.len() < at + width {
+            return Err(DeviceError::Capacity(format!(
+                "sums of {width} doubles from {at} into {}",
+                out.len()
+            )));
+        }
         loop {
             let g = groups(rows);
-            let into = if g == 1 { &*out } else { &self.folded };
+            let (into, offset) = if g == 1 { (out, at) } else { (&self.folded, 0) };
             // SAFETY: the parameters of sum_records (sums.cu): `rows` holds `rows`
             // rows of `width`, `into` room for `g`.
             unsafe {
@@ -91,6 +98,7 @@ impl RowSums {
                         self.rows.arg(),
                         Arg::U32(g as u32),
                         into.arg(),
+                        Arg::U32(offset as u32),
                     ],
                 )?;
             }
@@ -112,15 +120,15 @@ pub(super) struct PairTerms<'a> {
 }
 
 /// Sums the elastic energy and dissipation of the `pairs` and of the wall contacts
-/// of `walls` for `n` particles into `totals` (elastic energy, dissipated energy,
-/// wall contacts, pair contacts), by the scratch `sums`.
+/// of `walls` for `n` particles into the readback's sums (elastic energy,
+/// dissipated energy, wall contacts, pair contacts), by the scratch `sums`.
 pub(super) fn sum_energies(
     sums: &mut RowSums,
     device: &mut dyn Device,
     pairs: &PairTerms,
     walls: &DeviceWalls,
     n: usize,
-    totals: &mut Array<Real>,
+    readback: &Readback,
 ) -> Result<(), DeviceError> {
     let first = first_rows(pairs.count);
     let wall_rows = if walls.is_empty() { 0 } else { n };
@@ -144,5 +152,11 @@ pub(super) fn sum_energies(
     if wall_rows > 0 {
         walls.energy_terms(device, n, rows, first)?;
     }
-    sums.fold(device, first + wall_rows, ENERGY_RECORD, totals)
+    sums.fold(
+        device,
+        first + wall_rows,
+        ENERGY_RECORD,
+        &readback.device,
+        readback::SUMS,
+    )
 }

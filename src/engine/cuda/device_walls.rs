@@ -13,6 +13,7 @@ use super::Kernel;
 use super::device::{Arg, Array, Device, DeviceError};
 use super::device_list::run;
 use super::device_sums::{RowSums, first_rows};
+use super::readback::{self, Readback};
 use crate::Real;
 use crate::engine::backend::WallKey;
 use crate::engine::cpu::motion::advance_walls;
@@ -62,12 +63,9 @@ pub(super) struct DeviceWalls {
     new: Slots,
     records: Array<Real>,
     record_facet: Array<u32>,
-    overflow: Array<u32>,
-    /// Scratch of the walls' sums.
+    /// Scratch of the walls' sums (folded into the readback: per wall its force
+    /// and torque, then per facet its force).
     sums: RowSums,
-    /// What the particles push on the walls: per wall its force and torque, then
-    /// per facet its force.
-    totals: Array<Real>,
 }
 
 /// What the wall kernel reads of the particles and their types.
@@ -113,9 +111,7 @@ impl DeviceWalls {
             new: Slots::default(),
             records: Array::default(),
             record_facet: Array::default(),
-            overflow: Array::default(),
             sums: RowSums::default(),
-            totals: Array::default(),
             host,
         };
         walls.wall_facets.write(device, &starts)?;
@@ -128,8 +124,6 @@ impl DeviceWalls {
         walls.normals.resize(device, 3 * facets)?;
         let count = walls.host.walls.len();
         walls.motion.resize(device, 9 * count)?;
-        walls.totals.resize(device, 6 * count + 3 * facets)?;
-        walls.overflow.resize(device, 1)?;
         for slots in [&mut walls.old, &mut walls.new] {
             slots.count.resize(device, n)?;
             slots.keys.resize(device, KEY * SLOTS * n)?;
@@ -169,7 +163,6 @@ impl DeviceWalls {
             &self.old.springs,
             &self.new.springs,
             &self.records,
-            &self.totals,
         ];
         let words = [
             &self.wall_facets,
@@ -177,7 +170,6 @@ impl DeviceWalls {
             &self.old.count,
             &self.new.count,
             &self.record_facet,
-            &self.overflow,
         ];
         doubles.iter().map(|a| a.bytes(device)).sum::<usize>()
             + words.iter().map(|a| a.bytes(device)).sum::<usize>()
@@ -242,25 +234,21 @@ impl DeviceWalls {
     }
 
     /// The particles' wall contacts, added to their forces and torques (after the
-    /// pairs' gather), and the walls' sums. Fails when a particle has more than
-    /// [`SLOTS`] wall contacts.
+    /// pairs' gather), and the walls' sums into the readback, whose flag says
+    /// whether a particle had more than [`SLOTS`] wall contacts.
     pub fn contacts(
         &mut self,
         device: &mut dyn Device,
         at: &WallInputs,
+        readback: &Readback,
     ) -> Result<(), DeviceError> {
         std::mem::swap(&mut self.old, &mut self.new);
         let (old, new) = (&self.old, &self.new);
         let walls = Arg::U32(self.host.walls.len() as u32);
         // SAFETY: the parameters of sphere_walls (walls.cu), every
         // array sized for its particles, slots, walls or facets.
+        readback.clear_flag(device)?;
         unsafe {
-            run(
-                device,
-                Kernel::ZeroWords,
-                1,
-                &[Arg::U32(1), self.overflow.arg()],
-            )?;
             run(
                 device,
                 Kernel::SphereWalls,
@@ -297,18 +285,12 @@ impl DeviceWalls {
                     at.force.arg(),
                     at.torque.arg(),
                     at.touching.arg(),
-                    self.overflow.arg(),
+                    readback.flag(),
                 ],
             )?;
         }
         // The walls' sums: rows of partial sums over every so-many particles, folded.
-        let facets = self
-            .host
-            .walls
-            .iter()
-            .map(|w| w.triangles.len())
-            .sum::<usize>();
-        let width = 6 * self.host.walls.len() + 3 * facets;
+        let width = self.sums_width();
         let rows = wall_sum_rows(at.n, width);
         let partials = self.sums.rows(device, rows, width)?;
         // SAFETY: the parameters of wall_sum_rows (walls.cu): the slots hold n
@@ -333,13 +315,15 @@ impl DeviceWalls {
                 ],
             )?;
         }
-        self.sums.fold(device, rows, width, &mut self.totals)?;
-        if self.overflow.get(device, 0)? != 0 {
-            return Err(DeviceError::Capacity(format!(
-                "sphere touching walls at more than {SLOTS} places at once"
-            )));
-        }
-        Ok(())
+        self.sums
+            .fold(device, rows, width, &readback.device, readback::WALLS)
+    }
+
+    /// Doubles of the walls' sums: per wall its force and torque, per facet its
+    /// force.
+    pub fn sums_width(&self) -> usize {
+        let facets: usize = self.host.walls.iter().map(|w| w.triangles.len()).sum();
+        6 * self.host.walls.len() + 3 * facets
     }
 
     /// Launches the energy terms of `n` particles' wall contacts into records
@@ -438,11 +422,10 @@ impl DeviceWalls {
             .sum())
     }
 
-    /// Copies the walls' poses, velocities, forces, torques and facet forces into
-    /// `world`.
-    pub fn download(&self, device: &dyn Device, world: &mut World) -> Result<(), DeviceError> {
-        let totals = self.totals.read(device)?;
-        let (walls, facet_force) = totals.split_at(6 * self.host.walls.len());
+    /// Copies the walls' poses and velocities, and their forces, torques and facet
+    /// forces of the last read `readback`, into `world`.
+    pub fn to_host(&self, readback: &Readback, world: &mut World) {
+        let (walls, facet_force) = readback.walls().split_at(6 * self.host.walls.len());
         let mut first = 0;
         for (w, (wall, moved)) in world.walls.iter_mut().zip(&self.host.walls).enumerate() {
             wall.pose = moved.pose;
@@ -456,7 +439,6 @@ impl DeviceWalls {
             }
             first += wall.triangles.len();
         }
-        Ok(())
     }
 
     /// The patches' friction springs by key, for particles of `ids`.

@@ -21,6 +21,7 @@ mod device_walls;
 pub mod driver;
 pub mod host;
 pub mod nvrtc;
+mod readback;
 pub mod spheres;
 
 /// A source file of `kernels/`.

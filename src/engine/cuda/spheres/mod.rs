@@ -26,6 +26,7 @@ use super::device::{Arg, Array, Device, DeviceError};
 use super::device_list::{DeviceList, ListInputs, run};
 use super::device_sums::{PairTerms, RowSums, sum_energies};
 use super::device_walls::{DeviceWalls, WallInputs};
+use super::readback::Readback;
 use crate::Real;
 use crate::contact::{RollingModel, pair_restitution};
 use crate::engine::neighbours::automatic_skin;
@@ -90,9 +91,6 @@ struct PairArrays {
     /// Each pair's elastic energy and dissipation.
     terms: Array<Real>,
     touching: Array<u8>,
-    /// The sums of the last evaluation: the contacts' elastic energy and
-    /// dissipation, the wall contacts and the pair contacts.
-    energies: Array<Real>,
 }
 
 /// A world of spheres on a device (see the module).
@@ -109,6 +107,8 @@ pub struct DeviceSpheres {
     walls: DeviceWalls,
     /// Scratch of the energy sums.
     sums: RowSums,
+    /// The step's sums and flag, read once a step.
+    readback: Readback,
 }
 
 fn flat<const K: usize, T: Copy>(items: impl Iterator<Item = [T; K]>) -> Vec<T> {
@@ -180,6 +180,7 @@ impl DeviceSpheres {
         let largest = radii.iter().copied().fold(0.0, Real::max);
         let list = DeviceList::new(skin, 2.0 * largest + skin);
         let walls = DeviceWalls::new(d, world, p.len())?;
+        let readback = Readback::new(d, walls.sums_width())?;
         let mut spheres = DeviceSpheres {
             device,
             n: p.len(),
@@ -191,6 +192,7 @@ impl DeviceSpheres {
             list,
             walls,
             sums: RowSums::default(),
+            readback,
         };
         spheres.upload_particles(world)?;
         Ok(spheres)
@@ -452,7 +454,7 @@ impl DeviceSpheres {
                 torque: &p.torque,
                 touching: &p.touching,
             };
-            self.walls.contacts(d, &at)?;
+            self.walls.contacts(d, &at, &self.readback)?;
         }
         let terms = PairTerms {
             count,
@@ -465,7 +467,15 @@ impl DeviceSpheres {
             &terms,
             &self.walls,
             self.n,
-            &mut pairs.energies,
-        )
+            &self.readback,
+        )?;
+        self.readback.read(d)?;
+        if self.readback.overflowed() {
+            return Err(DeviceError::Capacity(format!(
+                "sphere touching walls at more than {} places at once",
+                super::device_walls::SLOTS
+            )));
+        }
+        Ok(())
     }
 }

@@ -47,6 +47,7 @@ impl DeviceSpheres {
             + self.list.bytes(d)
             + self.walls.bytes(d)
             + self.sums.bytes(d)
+            + self.readback.device.bytes(d)
     }
 
     /// The elastic energy held in the contacts and the energy they dissipated over
@@ -54,15 +55,15 @@ impl DeviceSpheres {
     /// `dissipated`, the same terms summed in a tree: equal to round-off; read back
     /// from the device).
     pub fn energies(&self) -> Result<(Real, Real), DeviceError> {
-        let e = self.pairs.energies.read(self.device.as_ref())?;
+        let e = self.readback.sums();
         Ok((e[0], e[1]))
     }
 
     /// The figures of the last force evaluation: contacts (pairs and walls), the
-    /// pairs', candidate pairs, elastic energy and dissipation, list builds (one
-    /// read of four numbers from the device).
+    /// pairs', candidate pairs, elastic energy and dissipation, list builds (of
+    /// the evaluation's one read).
     pub fn stats(&self) -> Result<crate::engine::StepStats, DeviceError> {
-        let e = self.pairs.energies.read(self.device.as_ref())?;
+        let e = self.readback.sums();
         let pair_contacts = e[3] as usize;
         Ok(crate::engine::StepStats {
             contacts: pair_contacts + e[2] as usize,
@@ -158,7 +159,8 @@ impl DeviceSpheres {
     /// the clock into `world`.
     pub fn walls_to_host(&self, world: &mut World) -> Result<(), DeviceError> {
         world.time = self.time;
-        self.walls.download(self.device.as_ref(), world)
+        self.walls.to_host(&self.readback, world);
+        Ok(())
     }
 
     /// Particle–wall contacts at the last force evaluation (read back from the
