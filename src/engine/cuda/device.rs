@@ -251,9 +251,8 @@ impl<T: Pod> Array<T> {
     /// Makes the array hold `len` elements: contents kept when the buffer is large
     /// enough, zeroed when a new one is allocated.
     pub fn resize(&mut self, device: &mut dyn Device, len: usize) -> Result<(), DeviceError> {
-        let bytes = (len.max(1)) * size_of::<T>();
-        let fits = self.buffer.is_some_and(|b| device.size(b) >= bytes);
-        if !fits {
+        if !self.has_room(device, len) {
+            let bytes = len.max(1) * size_of::<T>();
             if let Some(b) = self.buffer.take() {
                 device.free(b);
             }
@@ -265,14 +264,17 @@ impl<T: Pod> Array<T> {
         Ok(())
     }
 
+    /// Whether the buffer holds `len` elements (at least one).
+    fn has_room(&self, device: &dyn Device, len: usize) -> bool {
+        self.buffer
+            .is_some_and(|b| device.size(b) >= len.max(1) * size_of::<T>())
+    }
+
     /// Appends `tail` after the elements when the buffer has room for them, and says
     /// whether it had (when not, the array is as it was).
     pub fn append(&mut self, device: &mut dyn Device, tail: &[T]) -> Result<bool, DeviceError> {
         let len = self.len + tail.len();
-        let fits = self
-            .buffer
-            .is_some_and(|b| device.size(b) >= len.max(1) * size_of::<T>());
-        if !fits {
+        if !self.has_room(device, len) {
             return Ok(false);
         }
         let first = self.len;

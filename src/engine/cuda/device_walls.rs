@@ -36,6 +36,13 @@ struct Slots {
     springs: Array<Real>,
 }
 
+/// The error of a sphere touching walls at more places than it has slots for.
+pub(super) fn too_many_wall_contacts() -> DeviceError {
+    DeviceError::Capacity(format!(
+        "sphere touching walls at more than {SLOTS} places at once"
+    ))
+}
+
 /// Doubles the rows of the walls' first pass may take together (32 MiB): a row for
 /// every 8 particles where that fits, fewer for walls of many facets (each row
 /// holds every facet).
@@ -391,9 +398,7 @@ impl DeviceWalls {
             };
             let s = count[i] as usize;
             if s == SLOTS {
-                return Err(DeviceError::Capacity(format!(
-                    "sphere touching walls at more than {SLOTS} places at once"
-                )));
+                return Err(too_many_wall_contacts());
             }
             let slot = SLOTS * i + s;
             keys[KEY * slot] = *wall as i64;

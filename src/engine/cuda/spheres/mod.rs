@@ -17,7 +17,7 @@
 //! rolling resistance, a fluid, ghosts of a decomposition, particles not stored in
 //! the order of their ids.
 
-use nalgebra::Vector3;
+use nalgebra::{Point3, UnitQuaternion, Vector3};
 
 mod transfer;
 
@@ -25,7 +25,7 @@ use super::Kernel;
 use super::device::{Arg, Array, Device, DeviceError};
 use super::device_list::{DeviceList, ListInputs, run};
 use super::device_sums::{PairTerms, RowSums, sum_energies};
-use super::device_walls::{DeviceWalls, WallInputs};
+use super::device_walls::{DeviceWalls, WallInputs, too_many_wall_contacts};
 use super::readback::Readback;
 use crate::Real;
 use crate::contact::{RollingModel, pair_restitution};
@@ -117,6 +117,20 @@ fn flat<const K: usize, T: Copy>(items: impl Iterator<Item = [T; K]>) -> Vec<T> 
 
 fn vectors(v: &[Vector3<Real>]) -> Vec<Real> {
     flat(v.iter().map(|x| [x.x, x.y, x.z]))
+}
+
+fn points(x: &[Point3<Real>]) -> Vec<Real> {
+    flat(x.iter().map(|x| [x.x, x.y, x.z]))
+}
+
+/// Quaternions as the kernels read them: i, j, k, w.
+fn quaternions(q: &[UnitQuaternion<Real>]) -> Vec<Real> {
+    flat(q.iter().map(|q| q.coords.into()))
+}
+
+/// Flags as bytes.
+fn bytes(flags: &[bool]) -> Vec<u8> {
+    flags.iter().map(|&f| u8::from(f)).collect()
 }
 
 impl DeviceSpheres {
@@ -232,19 +246,14 @@ impl DeviceSpheres {
     /// Copies the particles' state to the device.
     fn upload_particles(&mut self, world: &World) -> Result<(), DeviceError> {
         let (d, a, p) = (self.device.as_mut(), &mut self.particles, &world.particles);
-        a.position
-            .write(d, &flat(p.position.iter().map(|x| [x.x, x.y, x.z])))?;
+        a.position.write(d, &points(&p.position))?;
         a.velocity.write(d, &vectors(&p.velocity))?;
-        a.orientation
-            .write(d, &flat(p.orientation.iter().map(|q| q.coords.into())))?;
+        a.orientation.write(d, &quaternions(&p.orientation))?;
         a.angular_momentum.write(d, &vectors(&p.angular_momentum))?;
         a.force.write(d, &vectors(&p.force))?;
         a.torque.write(d, &vectors(&p.torque))?;
         a.body_type.write(d, &p.body_type)?;
-        a.frozen.write(
-            d,
-            &p.frozen.iter().map(|&f| u8::from(f)).collect::<Vec<_>>(),
-        )?;
+        a.frozen.write(d, &bytes(&p.frozen))?;
         a.id.write(d, &p.id)?;
         a.touching.resize(d, p.len())?;
         self.list.invalidate();
@@ -256,9 +265,9 @@ impl DeviceSpheres {
         self.device.description()
     }
 
-    /// Pairs that touched at the last force evaluation (read from the device).
-    pub fn contacts(&self) -> Result<usize, DeviceError> {
-        Ok(self.stats()?.pair_contacts)
+    /// Pairs that touched at the last force evaluation.
+    pub fn pair_contacts(&self) -> usize {
+        self.stats().pair_contacts
     }
 
     /// Particles on the device.
@@ -471,10 +480,7 @@ impl DeviceSpheres {
         )?;
         self.readback.read(d)?;
         if self.readback.overflowed() {
-            return Err(DeviceError::Capacity(format!(
-                "sphere touching walls at more than {} places at once",
-                super::device_walls::SLOTS
-            )));
+            return Err(too_many_wall_contacts());
         }
         Ok(())
     }

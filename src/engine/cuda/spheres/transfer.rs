@@ -4,7 +4,7 @@
 
 use nalgebra::{Point3, Quaternion, UnitQuaternion, Vector3};
 
-use super::{DeviceSpheres, HISTORY, flat, vectors};
+use super::{DeviceSpheres, HISTORY, bytes, points, quaternions, vectors};
 use crate::Real;
 use crate::contact::TangentialHistory;
 use crate::engine::backend::ContactHistory;
@@ -52,20 +52,20 @@ impl DeviceSpheres {
 
     /// The elastic energy held in the contacts and the energy they dissipated over
     /// the last step, J (the CPU backend's `StepStats::elastic_energy` and
-    /// `dissipated`, the same terms summed in a tree: equal to round-off; read back
-    /// from the device).
-    pub fn energies(&self) -> Result<(Real, Real), DeviceError> {
+    /// `dissipated`, the same terms summed in a tree: equal to round-off; of the
+    /// evaluation's read-back).
+    pub fn energies(&self) -> (Real, Real) {
         let e = self.readback.sums();
-        Ok((e[0], e[1]))
+        (e[0], e[1])
     }
 
     /// The figures of the last force evaluation: contacts (pairs and walls), the
     /// pairs', candidate pairs, elastic energy and dissipation, list builds (of
-    /// the evaluation's one read).
-    pub fn stats(&self) -> Result<crate::engine::StepStats, DeviceError> {
+    /// the evaluation's read-back).
+    pub fn stats(&self) -> crate::engine::StepStats {
         let e = self.readback.sums();
         let pair_contacts = e[3] as usize;
-        Ok(crate::engine::StepStats {
+        crate::engine::StepStats {
             contacts: pair_contacts + e[2] as usize,
             pair_contacts,
             candidate_pairs: self.list.pair_count,
@@ -74,7 +74,7 @@ impl DeviceSpheres {
             dissipated: e[1],
             fluid_work: 0.0,
             list_builds: self.list.builds,
-        })
+        }
     }
 
     /// Gives the device back, its buffers released.
@@ -112,12 +112,10 @@ impl DeviceSpheres {
         let p = &world.particles;
         let (from, n) = (self.n, p.len());
         let (d, a) = (self.device.as_mut(), &mut self.particles);
-        grow(d, &mut a.position, from, n, |r| {
-            flat(p.position[r].iter().map(|x| [x.x, x.y, x.z]))
-        })?;
+        grow(d, &mut a.position, from, n, |r| points(&p.position[r]))?;
         grow(d, &mut a.velocity, from, n, |r| vectors(&p.velocity[r]))?;
         grow(d, &mut a.orientation, from, n, |r| {
-            flat(p.orientation[r].iter().map(|q| q.coords.into()))
+            quaternions(&p.orientation[r])
         })?;
         grow(d, &mut a.angular_momentum, from, n, |r| {
             vectors(&p.angular_momentum[r])
@@ -125,9 +123,7 @@ impl DeviceSpheres {
         grow(d, &mut a.force, from, n, |r| vectors(&p.force[r]))?;
         grow(d, &mut a.torque, from, n, |r| vectors(&p.torque[r]))?;
         grow(d, &mut a.body_type, from, n, |r| p.body_type[r].to_vec())?;
-        grow(d, &mut a.frozen, from, n, |r| {
-            p.frozen[r].iter().map(|&f| u8::from(f)).collect()
-        })?;
+        grow(d, &mut a.frozen, from, n, |r| bytes(&p.frozen[r]))?;
         grow(d, &mut a.id, from, n, |r| p.id[r].to_vec())?;
         a.touching.resize(d, n)?;
         self.walls.grow(d, n)?;
@@ -141,10 +137,7 @@ impl DeviceSpheres {
     /// stays (pairs of frozen particles drop out of the contacts, not the list).
     pub fn motion_from_host(&mut self, world: &World) -> Result<(), DeviceError> {
         let (d, a, p) = (self.device.as_mut(), &mut self.particles, &world.particles);
-        a.frozen.write(
-            d,
-            &p.frozen.iter().map(|&f| u8::from(f)).collect::<Vec<_>>(),
-        )?;
+        a.frozen.write(d, &bytes(&p.frozen))?;
         a.velocity.write(d, &vectors(&p.velocity))?;
         a.angular_momentum.write(d, &vectors(&p.angular_momentum))
     }
@@ -155,12 +148,11 @@ impl DeviceSpheres {
         self.walls.set_from(self.device.as_mut(), world)
     }
 
-    /// Copies the walls' poses, velocities, forces, torques and facet forces and
-    /// the clock into `world`.
-    pub fn walls_to_host(&self, world: &mut World) -> Result<(), DeviceError> {
+    /// Copies the walls' poses, velocities, forces, torques and facet forces (of
+    /// the evaluation's read-back) and the clock into `world`.
+    pub fn walls_to_host(&self, world: &mut World) {
         world.time = self.time;
         self.walls.to_host(&self.readback, world);
-        Ok(())
     }
 
     /// Particle–wall contacts at the last force evaluation (read back from the
@@ -173,7 +165,8 @@ impl DeviceSpheres {
     /// `world` (the world the stepper was made from, or a copy of it).
     pub fn download(&self, world: &mut World) -> Result<(), DeviceError> {
         self.particles_to_host(world)?;
-        self.walls_to_host(world)
+        self.walls_to_host(world);
+        Ok(())
     }
 
     /// Copies the particles' state and forces into `world`.
