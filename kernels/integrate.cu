@@ -21,6 +21,10 @@ static __device__ __forceinline__ Vec3 cayley_transpose(Vec3 w, Vec3 v) {
 
 // The torque-free rotation over dt of a body of principal moments `inertia`.
 static __device__ void free_rotation(Quat* q, Vec3* l, Vec3 inertia, double dt) {
+    if (l->x == 0.0 && l->y == 0.0 && l->z == 0.0) {
+        // Without angular momentum the body does not turn (integrate.rs).
+        return;
+    }
     double most = fmax(inertia.x, fmax(inertia.y, inertia.z));
     double least = fmin(inertia.x, fmin(inertia.y, inertia.z));
     if (most - least <= 1e-12 * most) {

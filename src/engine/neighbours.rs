@@ -28,7 +28,7 @@
 //! sphere contacts themselves; a settled bed keeps its lists for hundreds of steps,
 //! and a falling one for a few dozen at the suggested step.
 
-use nalgebra::Point3;
+use nalgebra::{Isometry3, Point3};
 use rayon::prelude::*;
 
 use super::broad_phase::BroadPhase;
@@ -84,11 +84,12 @@ pub struct NeighbourList {
     facet_starts: Vec<u32>,
     facets: Vec<u32>,
     /// What the lists were built from: particle ids and positions, positions in every
-    /// wall's frame (particle-major), and each wall's facet count.
+    /// wall's frame (particle-major), and each wall's facet count and pose.
     ids: Vec<u64>,
     anchors: Vec<Point3<Real>>,
     wall_anchors: Vec<Point3<Real>>,
     wall_facets: Vec<usize>,
+    wall_poses: Vec<Isometry3<Real>>,
     /// Skin the lists were built with.
     built_skin: Real,
     valid: bool,
@@ -150,13 +151,20 @@ impl NeighbourList {
         let s = self.built_skin;
         let (pair_limit, wall_limit) = ((0.5 * s) * (0.5 * s), s * s);
         let walls = self.wall_facets.len();
+        // A wall at its pose of the build sees a particle move as far as the world
+        // does, and the pairs' limit is the stricter: only moved walls are checked.
+        let moved = |w: usize| world.walls[w].pose != self.wall_poses[w];
+        let any_moved = (0..walls).any(moved);
         (0..p.len()).into_par_iter().any(|k| {
             let x = p.position[k];
             (x - self.anchors[k]).norm_squared() >= pair_limit
-                || world.walls.iter().enumerate().any(|(w, wall)| {
-                    let local = wall.pose.inverse_transform_point(&x);
-                    (local - self.wall_anchors[k * walls + w]).norm_squared() >= wall_limit
-                })
+                || any_moved
+                    && world.walls.iter().enumerate().any(|(w, wall)| {
+                        let local = wall.pose.inverse_transform_point(&x);
+                        moved(w)
+                            && (local - self.wall_anchors[k * walls + w]).norm_squared()
+                                >= wall_limit
+                    })
         })
     }
 
@@ -204,6 +212,8 @@ impl NeighbourList {
         self.wall_facets.clear();
         self.wall_facets
             .extend(world.walls.iter().map(|w| w.triangles.len()));
+        self.wall_poses.clear();
+        self.wall_poses.extend(world.walls.iter().map(|w| w.pose));
         self.valid = true;
         self.builds += 1;
     }

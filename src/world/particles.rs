@@ -75,19 +75,33 @@ impl Particles {
     }
 
     /// Whether every owned particle [`is_finite`](Self::is_finite): one branch-free
-    /// sweep (`x · 0` is 0 for a finite `x` and NaN otherwise, and a sum holding a NaN
-    /// is NaN), cheap enough for every step.
+    /// sweep, cheap enough for every step (`x · 0` is 0 for a finite `x` and NaN
+    /// otherwise, and a sum holding a NaN is NaN).
     pub fn all_finite(&self) -> bool {
-        // Each component times zero, so that large finite values cannot overflow.
-        fn zeros<'a>(v: impl Iterator<Item = &'a Vector3<Real>>) -> Real {
-            v.map(|x| x.x * 0.0 + x.y * 0.0 + x.z * 0.0).sum()
+        // Four running sums taken in turn, so that four chains of adds overlap instead
+        // of each add waiting on the one before.
+        fn zeros<T>(v: &[T], coords: impl Fn(&T) -> &Vector3<Real>) -> Real {
+            let mut sums = [Vector3::zeros(); 4];
+            let chunks = v.chunks_exact(4);
+            for x in chunks.remainder() {
+                sums[0] += coords(x) * 0.0;
+            }
+            for chunk in chunks {
+                for (sum, x) in sums.iter_mut().zip(chunk) {
+                    *sum += coords(x) * 0.0;
+                }
+            }
+            sums.iter().map(|s| s.x + s.y + s.z).sum()
         }
         let n = self.owned();
-        (zeros(self.position[..n].iter().map(|x| &x.coords))
-            + zeros(self.velocity[..n].iter())
-            + zeros(self.angular_momentum[..n].iter())
-            + zeros(self.force[..n].iter())
-            + zeros(self.torque[..n].iter()))
+        fn vector(x: &Vector3<Real>) -> &Vector3<Real> {
+            x
+        }
+        (zeros(&self.position[..n], |x: &Point3<Real>| &x.coords)
+            + zeros(&self.velocity[..n], vector)
+            + zeros(&self.angular_momentum[..n], vector)
+            + zeros(&self.force[..n], vector)
+            + zeros(&self.torque[..n], vector))
             == 0.0
     }
 

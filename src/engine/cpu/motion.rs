@@ -4,17 +4,40 @@
 use rayon::prelude::*;
 
 use crate::Real;
-use crate::engine::integrate::{RotationState, free_rotation, half_kick};
-use crate::world::World;
+use crate::engine::integrate::{RotationState, free_rotation, half_kick, turn_isotropic};
+use crate::geometry::is_isotropic;
+use crate::world::{BodyType, World};
 
 /// Smallest share of particles one rayon task takes: below it the scheduling costs
 /// more than the work.
 const PARTICLES_PER_TASK: usize = 256;
 
+/// What a step's integration of one body type divides by, divided once: the same
+/// quotients every particle of the type computed for itself before, so the same bits.
+#[derive(Clone, Copy, Debug)]
+struct TypeStep {
+    /// `h / (2 m)`: a half kick's velocity change per newton.
+    kick: Real,
+    /// `h / (2 I)` of an isotropic body ([`turn_isotropic`]); `None` for another.
+    turn: Option<Real>,
+}
+
+/// Every body type's [`TypeStep`] for a step of `dt`.
+fn type_steps(types: &[BodyType], dt: Real) -> Vec<TypeStep> {
+    types
+        .iter()
+        .map(|t| TypeStep {
+            kick: 0.5 * dt / t.mass,
+            turn: is_isotropic(&t.inertia).then(|| 0.5 * dt / t.inertia.x),
+        })
+        .collect()
+}
+
 /// Half kick with the forces of the last evaluation, drift, and free rotation of every
 /// owned particle that is not frozen. Returns how many were integrated.
 pub(crate) fn kick_drift(world: &mut World, dt: Real) -> usize {
     let types = &world.body_types;
+    let steps = type_steps(types, dt);
     let p = &mut world.particles;
     let n = p.owned();
     (
@@ -35,15 +58,18 @@ pub(crate) fn kick_drift(world: &mut World, dt: Real) -> usize {
             if frozen {
                 return;
             }
-            let kind = &types[kind as usize];
-            *v += f * (0.5 * dt / kind.mass);
+            let step = &steps[kind as usize];
+            *v += f * step.kick;
             *x += *v * dt;
             let mut rot = RotationState {
                 orientation: *q,
                 angular_momentum: *l,
             };
             half_kick(&mut rot, t, dt);
-            free_rotation(&mut rot, &kind.inertia, dt);
+            match step.turn {
+                Some(half_step) => turn_isotropic(&mut rot, half_step),
+                None => free_rotation(&mut rot, &types[kind as usize].inertia, dt),
+            }
             *q = rot.orientation;
             *l = rot.angular_momentum;
         });
@@ -62,7 +88,7 @@ pub(crate) fn advance_walls(world: &mut World, dt: Real) {
 
 /// The closing half kick with the forces just evaluated.
 pub(crate) fn closing_kick(world: &mut World, dt: Real) {
-    let types = &world.body_types;
+    let steps = type_steps(&world.body_types, dt);
     let p = &mut world.particles;
     let n = p.owned();
     (&mut p.velocity[..n], &mut p.angular_momentum[..n])
@@ -78,7 +104,7 @@ pub(crate) fn closing_kick(world: &mut World, dt: Real) {
             if frozen {
                 return;
             }
-            *v += f * (0.5 * dt / types[kind as usize].mass);
+            *v += f * steps[kind as usize].kick;
             *l += t * (0.5 * dt);
         });
 }
