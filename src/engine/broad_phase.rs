@@ -2,12 +2,12 @@
 //!
 //! # Method
 //! Particles are binned on uniform cell grids by a counting sort (cell index per
-//! particle, per-cell counts, an exclusive prefix sum to cell starts, a scatter), and
-//! the candidate pairs are written to one flat array: a first pass counts each
-//! particle's pairs, a prefix sum turns the counts into offsets, and a second pass
-//! writes every particle's pairs into its own slice (the contact-pair
-//! parallelism). Both passes are data-parallel over particles and the output order
-//! does not depend on the number of threads.
+//! particle, per-cell counts, an exclusive prefix sum to cell starts, a scatter), with
+//! their positions and radii copied in cell order, and the candidate pairs are
+//! written to one flat array: the particles, in cell order, each look through half
+//! the 27-cell stencil about them (every pair of neighbouring cells is searched from
+//! one side only), in parallel over runs of particles whose pairs are appended in
+//! order, so the output order does not depend on the number of threads.
 //!
 //! # Wide size distributions
 //! One grid sized for the largest particle would put hundreds of small ones in a cell
@@ -33,6 +33,10 @@ struct GridLevel {
     dims: [usize; 3],
     /// Particles of this level, ordered by cell.
     sorted: Vec<u32>,
+    /// Their positions and bounding radii in the same order, so that a stencil's
+    /// cells are read from contiguous memory.
+    positions: Vec<Point3<Real>>,
+    radii: Vec<Real>,
     /// `sorted[starts[c]..starts[c + 1]]` are the particles in cell `c`.
     starts: Vec<u32>,
 }
@@ -61,16 +65,18 @@ pub struct BroadPhase {
     levels: Vec<GridLevel>,
     level_of: Vec<u8>,
     origin: Vector3<Real>,
-    counts: Vec<u32>,
 }
+
+/// Smallest run of particles one rayon task takes.
+const PARTICLES_PER_TASK: usize = 256;
 
 /// Most levels in the hierarchy (radius ratio up to 2^16).
 const MAX_LEVELS: usize = 16;
 
 impl BroadPhase {
     /// All pairs `[i, j]` (`i < j`) with `|x_i − x_j| < r_i + r_j + skin`, written to
-    /// `pairs` grouped by the particle that found them (the smaller member; the lower
-    /// index within a size class), in an order that does not depend on the number of
+    /// `pairs` grouped by the particle that found them (levels from the coarsest,
+    /// particles in cell order), in an order that does not depend on the number of
     /// threads.
     pub fn find_pairs(
         &mut self,
@@ -85,33 +91,26 @@ impl BroadPhase {
             return;
         }
         self.build(positions, radii, skin);
-        let mut counts = std::mem::take(&mut self.counts);
+        // Each level's particles in cell order look for their partners, in parallel
+        // over contiguous runs whose pairs are appended in order: the output does not
+        // depend on how the runs were split among threads.
         let this = &*self;
-        counts.clear();
-        counts.par_extend((0..n).into_par_iter().map(|i| {
-            let mut k = 0u32;
-            this.visit_partners(i, positions, radii, skin, |_| k += 1);
-            k
-        }));
-        let total: usize = counts.iter().map(|&k| k as usize).sum();
-        pairs.resize(total, [0, 0]);
-        // One output slice per particle, sized by its count (the prefix sum), filled in
-        // parallel.
-        let mut slices: Vec<&mut [[u32; 2]]> = Vec::with_capacity(n);
-        let mut rest: &mut [[u32; 2]] = pairs;
-        for &k in &counts {
-            let (head, tail) = rest.split_at_mut(k as usize);
-            slices.push(head);
-            rest = tail;
+        for (level, grid) in self.levels.iter().enumerate() {
+            let runs: Vec<Vec<[u32; 2]>> = (0..grid.sorted.len())
+                .into_par_iter()
+                .with_min_len(PARTICLES_PER_TASK)
+                .fold(Vec::new, |mut out, m| {
+                    let i = grid.sorted[m] as usize;
+                    this.visit_partners(level, m, skin, |j| {
+                        out.push([i.min(j) as u32, i.max(j) as u32]);
+                    });
+                    out
+                })
+                .collect();
+            for run in runs {
+                pairs.extend_from_slice(&run);
+            }
         }
-        slices.into_par_iter().enumerate().for_each(|(i, out)| {
-            let mut k = 0;
-            this.visit_partners(i, positions, radii, skin, |j| {
-                out[k] = [i.min(j) as u32, i.max(j) as u32];
-                k += 1;
-            });
-        });
-        self.counts = counts;
     }
 
     /// Bins the particles on the level grids (counting sort per level).
@@ -179,42 +178,76 @@ impl BroadPhase {
                 grid.sorted[fill[c] as usize] = i as u32;
                 fill[c] += 1;
             }
+            grid.positions.clear();
+            grid.positions
+                .extend(grid.sorted.iter().map(|&i| positions[i as usize]));
+            grid.radii.clear();
+            grid.radii
+                .extend(grid.sorted.iter().map(|&i| radii[i as usize]));
         }
     }
 
-    /// Calls `found(j)` for every partner `j` of particle `i` (see [`Self::find_pairs`]).
-    fn visit_partners(
-        &self,
-        i: usize,
-        positions: &[Point3<Real>],
-        radii: &[Real],
-        skin: Real,
-        mut found: impl FnMut(usize),
-    ) {
-        let own = self.level_of[i] as usize;
-        let p = positions[i];
-        for level in 0..=own {
-            let grid = &self.levels[level];
+    /// Calls `found(j)` for every partner `j` of the particle at `m` in the cell order
+    /// of level `own` (see [`Self::find_pairs`]): in its own level, the partners in
+    /// its own cell after it and in the 13 neighbour cells of the forward half of the
+    /// stencil (each pair of a level is found once, from one of its two cells); in
+    /// every coarser level, all partners in the 27 cells about it.
+    fn visit_partners(&self, own: usize, m: usize, skin: Real, mut found: impl FnMut(usize)) {
+        let grid = &self.levels[own];
+        let (p, r) = (grid.positions[m], grid.radii[m]);
+        let mut visit = |grid: &GridLevel, members: std::ops::Range<usize>| {
+            for k in members {
+                let reach = r + grid.radii[k] + skin;
+                if (grid.positions[k] - p).norm_squared() < reach * reach {
+                    found(grid.sorted[k] as usize);
+                }
+            }
+        };
+        let c = grid.coords(&p, &self.origin);
+        let cell = grid.index(c);
+        visit(grid, m + 1..grid.starts[cell + 1] as usize);
+        for [dx, dy, dz] in FORWARD {
+            let neighbour = [c[0] as isize + dx, c[1] as isize + dy, c[2] as isize + dz];
+            if (0..3).all(|k| (0..grid.dims[k] as isize).contains(&neighbour[k])) {
+                let cell = grid.index(neighbour.map(|x| x as usize));
+                visit(
+                    grid,
+                    grid.starts[cell] as usize..grid.starts[cell + 1] as usize,
+                );
+            }
+        }
+        for grid in &self.levels[..own] {
             let c = grid.coords(&p, &self.origin);
             let range = |k: usize| c[k].saturating_sub(1)..=(c[k] + 1).min(grid.dims[k] - 1);
             for z in range(2) {
                 for y in range(1) {
                     for x in range(0) {
                         let cell = grid.index([x, y, z]);
-                        let members = grid.starts[cell] as usize..grid.starts[cell + 1] as usize;
-                        for &j in &grid.sorted[members] {
-                            let j = j as usize;
-                            if level == own && j <= i {
-                                continue;
-                            }
-                            let reach = radii[i] + radii[j] + skin;
-                            if (positions[j] - p).norm_squared() < reach * reach {
-                                found(j);
-                            }
-                        }
+                        visit(
+                            grid,
+                            grid.starts[cell] as usize..grid.starts[cell + 1] as usize,
+                        );
                     }
                 }
             }
         }
     }
 }
+
+/// The 13 neighbour cells of the forward half of a 27-cell stencil: the offsets that
+/// come after `(0, 0, 0)` in the order `(z, y, x)`.
+const FORWARD: [[isize; 3]; 13] = [
+    [1, 0, 0],
+    [-1, 1, 0],
+    [0, 1, 0],
+    [1, 1, 0],
+    [-1, -1, 1],
+    [0, -1, 1],
+    [1, -1, 1],
+    [-1, 0, 1],
+    [0, 0, 1],
+    [1, 0, 1],
+    [-1, 1, 1],
+    [0, 1, 1],
+    [1, 1, 1],
+];
