@@ -138,12 +138,34 @@ fn a_run_killed_anywhere_and_resumed_gives_the_same_outputs() {
     let dir = scratch("resume_killed");
     let scene = write_scene(&dir, "0.1");
     let (whole, killed) = (dir.join("whole"), dir.join("killed"));
-    finished(
-        talus(&[Path::new("run"), &scene, Path::new("--out"), &whole])
-            .output()
-            .unwrap(),
-    );
+    let run = talus(&[Path::new("run"), &scene, Path::new("--out"), &whole])
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&run.stdout).to_string();
+    finished(run);
     assert_eq!(rows(&whole), 102, "a header, t = 0 and 100 rows");
+    // Below the summary, the last step's contacts among its candidate pairs (those of
+    // summary.json) and each stage's share of the run, adding up to the whole.
+    let line = stdout
+        .lines()
+        .find_map(|l| l.trim().strip_prefix("last step: "))
+        .unwrap_or_else(|| panic!("no last-step line: {stdout}"));
+    let (counts, stages) = line.split_once("; stages: ").expect(line);
+    let words: Vec<&str> = counts.split_whitespace().collect();
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(whole.join("summary.json")).unwrap())
+            .unwrap();
+    assert_eq!(words[0], summary["contacts"].to_string(), "{line}");
+    assert_eq!(words[3], summary["candidate_pairs"].to_string(), "{line}");
+    let (contacts, candidates): (usize, usize) =
+        (words[0].parse().unwrap(), words[3].parse().unwrap());
+    assert!(contacts > 0 && candidates >= contacts, "{line}");
+    let shares: Vec<f64> = stages
+        .split(", ")
+        .map(|s| s.rsplit(' ').nth(1).unwrap().parse().unwrap())
+        .collect();
+    assert_eq!(shares.len(), 8, "{stages}");
+    assert!((shares.iter().sum::<f64>() - 100.0).abs() < 0.5, "{stages}");
 
     let seed = SystemTime::now()
         .duration_since(SystemTime::UNIX_EPOCH)

@@ -530,8 +530,8 @@ fn print_row(name: &str, threads: usize, m: &Measured, dt: f64, error: &str) {
     }
 }
 
-/// Stage shares as `name 12.3 %, ...`.
-fn stage_line(stages: &[(&str, f64)]) -> String {
+/// Stage shares as `name 12.3 %, ...`, in step order.
+pub(crate) fn stage_line(stages: &[(&str, f64)]) -> String {
     stages
         .iter()
         .map(|(name, share)| format!("{name} {:.1} %", 100.0 * share))

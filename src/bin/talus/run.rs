@@ -358,6 +358,21 @@ fn run_loop(
         summary.energy.dissipated,
         dir.display()
     );
+    let stages: Vec<(&str, f64)> = summary
+        .stages
+        .iter()
+        .map(|s| (s.stage.as_str(), s.share))
+        .collect();
+    println!(
+        "  last step: {} contacts of {} candidate pairs; stages: {}",
+        summary.contacts,
+        summary.candidate_pairs,
+        if stages.iter().any(|s| s.1 > 0.0) {
+            crate::bench::stage_line(&stages)
+        } else {
+            "not timed apart by this backend".into()
+        }
+    );
     Ok(())
 }
 
