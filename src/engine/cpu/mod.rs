@@ -11,6 +11,7 @@
 //! walls' totals do, by round-off; `tests/memory_order.rs`).
 //!
 //! The parts: [`motion`] (integration stages), [`pairs`] (pair contacts and gather),
+//! [`fused`] (the two fused, on one thread),
 //! [`walls`] (wall stage), [`dispatch`] (shape pair → contact geometry), [`patch`]
 //! (coplanar facets merged into one contact), [`relative_motion`] (how the bodies
 //! move at a contact), [`forces`] (geometry → force through the contact laws),
@@ -20,6 +21,7 @@ mod contact_state;
 mod dispatch;
 mod fluid;
 mod forces;
+mod fused;
 mod hertz;
 pub(crate) mod motion;
 mod pairs;
@@ -121,23 +123,37 @@ impl CpuBackend {
         times.time(Stage::NeighbourList, || {
             update_list(list, contacts, world, &mut work.radii)
         });
-        times.time(Stage::PairContacts, || {
-            pairs::pair_contacts(
-                world,
-                list,
-                contacts,
-                &work.radii,
-                pairs::PairLaws {
-                    laws,
-                    round: params.round_law,
-                    dt,
-                },
-                &mut work.results,
-            )
-        });
-        let totals = times.time(Stage::Gather, || {
-            pairs::gather(world, list, &work.results, &mut work.touching)
-        });
+        let pair_laws = pairs::PairLaws {
+            laws,
+            round: params.round_law,
+            dt,
+        };
+        let totals = if fused::fused() {
+            times.time(Stage::PairContacts, || {
+                fused::pair_contacts_gathered(
+                    world,
+                    list,
+                    contacts,
+                    &work.radii,
+                    pair_laws,
+                    &mut work.touching,
+                )
+            })
+        } else {
+            times.time(Stage::PairContacts, || {
+                pairs::pair_contacts(
+                    world,
+                    list,
+                    contacts,
+                    &work.radii,
+                    pair_laws,
+                    &mut work.results,
+                )
+            });
+            times.time(Stage::Gather, || {
+                pairs::gather(world, list, &work.results, &mut work.touching)
+            })
+        };
         let (pair_contacts, candidate_pairs) = (totals.contacts, totals.candidates);
         let totals = times.time(Stage::WallContacts, || {
             let inputs = WallInputs {

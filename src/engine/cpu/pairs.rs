@@ -14,7 +14,7 @@ use crate::engine::RoundLaw;
 use crate::engine::laws::ContactLaws;
 use crate::engine::neighbours::NeighbourList;
 use crate::geometry::overlap::OverlapCache;
-use crate::world::World;
+use crate::world::{BodyType, Particles, World};
 
 /// Smallest share of pairs and of particles one rayon task takes.
 const PAIRS_PER_TASK: usize = 64;
@@ -96,10 +96,46 @@ fn pair_contact(
     }
 }
 
-/// Evaluates every candidate pair into `results` (aligned with the pairs). Each
-/// pair's history is replaced by the one its contact leaves (empty when they do not
-/// touch). Two passive particles (frozen or ghost) push on nothing that moves here:
-/// their pair is skipped.
+/// The result of candidate pair `[i, j]` (`radii`: bounding radii), its history
+/// replaced by the one its contact leaves (empty when they do not touch). Two
+/// passive particles (frozen or ghost) push on nothing that moves here: their pair
+/// is skipped.
+#[inline]
+pub(super) fn evaluate_pair(
+    world: &World,
+    radii: &[Real],
+    laws: &PairLaws,
+    [i, j]: [u32; 2],
+    history: &mut TangentialHistory,
+    plan: &mut OverlapCache,
+) -> PairResult {
+    let p = &world.particles;
+    let (i, j) = (i as usize, j as usize);
+    let reach = radii[i] + radii[j];
+    let c = if !(p.is_passive(i) && p.is_passive(j))
+        && (p.position[j] - p.position[i]).norm_squared() < reach * reach
+    {
+        pair_contact(world, i, j, plan, history, laws)
+    } else {
+        None
+    };
+    // A pair that stays apart keeps its empty history unwritten.
+    match &c {
+        Some(c) => {
+            *history = c.history;
+            PairResult::new(c, &p.position[i], &p.position[j])
+        }
+        None if !history.is_empty() => {
+            let parted = PairResult::parted(history);
+            *history = TangentialHistory::default();
+            parted
+        }
+        None => PairResult::default(),
+    }
+}
+
+/// Evaluates every candidate pair into `results` (aligned with the pairs), in
+/// parallel ([`evaluate_pair`]).
 pub(super) fn pair_contacts(
     world: &World,
     list: &NeighbourList,
@@ -108,30 +144,8 @@ pub(super) fn pair_contacts(
     laws: PairLaws,
     results: &mut Vec<PairResult>,
 ) {
-    let p = &world.particles;
-    let evaluate = |[i, j]: [u32; 2], history: &mut TangentialHistory, plan: &mut OverlapCache| {
-        let (i, j) = (i as usize, j as usize);
-        let reach = radii[i] + radii[j];
-        let c = if !(p.is_passive(i) && p.is_passive(j))
-            && (p.position[j] - p.position[i]).norm_squared() < reach * reach
-        {
-            pair_contact(world, i, j, plan, history, &laws)
-        } else {
-            None
-        };
-        // A pair that stays apart keeps its empty history unwritten.
-        match &c {
-            Some(c) => {
-                *history = c.history;
-                PairResult::new(c, &p.position[i], &p.position[j])
-            }
-            None if !history.is_empty() => {
-                let parted = PairResult::parted(history);
-                *history = TangentialHistory::default();
-                parted
-            }
-            None => PairResult::default(),
-        }
+    let evaluate = |pair, history: &mut _, plan: &mut _| {
+        evaluate_pair(world, radii, &laws, pair, history, plan)
     };
     results.clear();
     let pairs = list.pairs().par_iter().zip(&mut state.pair_history);
@@ -166,46 +180,75 @@ pub(super) fn gather(
 ) -> ContactTotals {
     let p = &mut world.particles;
     let owned = p.owned();
-    let (types, gravity) = (&world.body_types, world.gravity);
+    let start = StartLoads {
+        owned,
+        body_type: &p.body_type,
+        frozen: &p.frozen,
+        types: &world.body_types,
+        gravity: world.gravity,
+    };
     touching.resize(p.len(), false);
     (&mut p.force, &mut p.torque, touching)
         .into_par_iter()
         .enumerate()
         .with_min_len(PARTICLES_PER_TASK)
         .for_each(|(k, (force, torque, touching))| {
-            *torque = Vector3::zeros();
+            (*force, *torque, *touching) = start.of(k);
             if k >= owned {
-                *force = Vector3::zeros();
-                *touching = false;
                 return;
             }
-            *force = gravity * types[p.body_type[k] as usize].mass;
-            // A frozen particle is part of a bed, whether or not its contacts are
-            // evaluated.
-            *touching = p.frozen[k];
             // Adding a pair apart adds zeros: `x + 0.0` is `x`, and `x + (−1)·f` is
             // `x − f`, so the sums are those of adding the touching pairs alone.
             for &e in list.incident(k) {
                 let c = &results[e.pair()];
-                let role = usize::from(!e.is_first());
-                let sign = if e.is_first() { -1.0 } else { 1.0 };
-                *touching |= c.touching;
-                *force += c.force * sign;
-                *torque += c.torques[role];
+                c.add_to((force, torque, touching), e.is_first());
             }
         });
     let p = &world.particles;
     let mut totals = ContactTotals::default();
     for (c, &[i, j]) in results.iter().zip(list.pairs()) {
-        if !p.counts_pair(i as usize, j as usize) {
-            continue;
-        }
-        totals.candidates += 1;
-        totals.contacts += usize::from(c.touching);
-        totals.energy += c.energy;
-        totals.dissipated += c.dissipated;
+        totals.count(p, [i, j], c);
     }
     totals
+}
+
+/// What a particle carries before its pairs are added: its weight if owned (a ghost
+/// gets no force), no torque, and touching if frozen (a frozen particle is part of a
+/// bed, whether or not its contacts are evaluated).
+#[derive(Clone, Copy)]
+pub(super) struct StartLoads<'a> {
+    pub owned: usize,
+    pub body_type: &'a [u32],
+    pub frozen: &'a [bool],
+    pub types: &'a [BodyType],
+    pub gravity: Vector3<Real>,
+}
+
+impl StartLoads<'_> {
+    /// Force, torque and touching flag of particle `k` before its pairs.
+    #[inline]
+    pub(super) fn of(&self, k: usize) -> (Vector3<Real>, Vector3<Real>, bool) {
+        if k >= self.owned {
+            return (Vector3::zeros(), Vector3::zeros(), false);
+        }
+        let force = self.gravity * self.types[self.body_type[k] as usize].mass;
+        (force, Vector3::zeros(), self.frozen[k])
+    }
+}
+
+impl PairResult {
+    /// Adds the result to the particle that is the pair's first (`first`) or second.
+    #[inline(always)]
+    pub(super) fn add_to(
+        &self,
+        (force, torque, touching): (&mut Vector3<Real>, &mut Vector3<Real>, &mut bool),
+        first: bool,
+    ) {
+        let sign = if first { -1.0 } else { 1.0 };
+        *touching |= self.touching;
+        *force += self.force * sign;
+        *torque += self.torques[usize::from(!first)];
+    }
 }
 
 /// A force evaluation's contacts, summed in pair order, then wall contacts in
@@ -219,4 +262,19 @@ pub(super) struct ContactTotals {
     pub energy: Real,
     /// Energy dissipated over the step, J.
     pub dissipated: Real,
+}
+
+impl ContactTotals {
+    /// Adds pair `[i, j]`'s result if this world counts the pair (see
+    /// [`Particles::counts_pair`]); called in pair order.
+    #[inline]
+    pub(super) fn count(&mut self, p: &Particles, [i, j]: [u32; 2], c: &PairResult) {
+        if !p.counts_pair(i as usize, j as usize) {
+            return;
+        }
+        self.candidates += 1;
+        self.contacts += usize::from(c.touching);
+        self.energy += c.energy;
+        self.dissipated += c.dissipated;
+    }
 }
