@@ -53,6 +53,8 @@ struct Workspace {
     /// Whether each particle touched another or a wall at the last force evaluation.
     touching: Vec<bool>,
     walls: WallWork,
+    /// Each body type's quotients of the integration.
+    type_steps: motion::TypeSteps,
 }
 
 /// The CPU engine: step parameters, persistent contact state, the neighbour list, the
@@ -86,9 +88,9 @@ impl CpuBackend {
     /// particles with other ranks refreshes their ghost copies here, before
     /// [`Self::forces`] (`step` is `drift`, `forces`, `close`).
     pub fn drift(&mut self, world: &mut World, dt: Real) {
-        self.stats.integrated = self
-            .times
-            .time(Stage::Integrate, || motion::kick_drift(world, dt));
+        self.stats.integrated = self.times.time(Stage::Integrate, || {
+            motion::kick_drift(world, dt, &mut self.work.type_steps)
+        });
         self.times
             .time(Stage::WallMotion, || motion::advance_walls(world, dt));
     }
@@ -100,8 +102,9 @@ impl CpuBackend {
 
     /// The closing half kick of the owned particles.
     pub fn close(&mut self, world: &mut World, dt: Real) {
-        self.times
-            .time(Stage::Integrate, || motion::closing_kick(world, dt));
+        self.times.time(Stage::Integrate, || {
+            motion::closing_kick(world, dt, &mut self.work.type_steps)
+        });
     }
 
     /// Forces and torques of the current positions and velocities, stage by stage.

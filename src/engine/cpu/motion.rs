@@ -22,22 +22,28 @@ struct TypeStep {
     turn: Option<Real>,
 }
 
-/// Every body type's [`TypeStep`] for a step of `dt`.
-fn type_steps(types: &[BodyType], dt: Real) -> Vec<TypeStep> {
-    types
-        .iter()
-        .map(|t| TypeStep {
+/// Every body type's [`TypeStep`], kept between steps so that a step allocates
+/// nothing.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct TypeSteps(Vec<TypeStep>);
+
+impl TypeSteps {
+    /// The steps of `types` for a step of `dt`.
+    fn of(&mut self, types: &[BodyType], dt: Real) -> &[TypeStep] {
+        self.0.clear();
+        self.0.extend(types.iter().map(|t| TypeStep {
             kick: 0.5 * dt / t.mass,
             turn: is_isotropic(&t.inertia).then(|| 0.5 * dt / t.inertia.x),
-        })
-        .collect()
+        }));
+        &self.0
+    }
 }
 
 /// Half kick with the forces of the last evaluation, drift, and free rotation of every
 /// owned particle that is not frozen. Returns how many were integrated.
-pub(crate) fn kick_drift(world: &mut World, dt: Real) -> usize {
+pub(crate) fn kick_drift(world: &mut World, dt: Real, steps: &mut TypeSteps) -> usize {
     let types = &world.body_types;
-    let steps = type_steps(types, dt);
+    let steps = steps.of(types, dt);
     let p = &mut world.particles;
     let n = p.owned();
     (
@@ -87,8 +93,8 @@ pub(crate) fn advance_walls(world: &mut World, dt: Real) {
 }
 
 /// The closing half kick with the forces just evaluated.
-pub(crate) fn closing_kick(world: &mut World, dt: Real) {
-    let steps = type_steps(&world.body_types, dt);
+pub(crate) fn closing_kick(world: &mut World, dt: Real, steps: &mut TypeSteps) {
+    let steps = steps.of(&world.body_types, dt);
     let p = &mut world.particles;
     let n = p.owned();
     (&mut p.velocity[..n], &mut p.angular_momentum[..n])

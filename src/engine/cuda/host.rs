@@ -234,7 +234,7 @@ max = [0.24, 0.04, 0.04]
         let before = world();
         let dt = 2e-4;
         let mut cpu = before.clone();
-        crate::engine::cpu::motion::kick_drift(&mut cpu, dt);
+        crate::engine::cpu::motion::kick_drift(&mut cpu, dt, &mut Default::default());
         let mut kernel = before.clone();
         HostExecutor { block: 32 }.kick_drift(&mut kernel, dt);
         let (a, b) = (&cpu.particles, &kernel.particles);
@@ -261,7 +261,7 @@ max = [0.24, 0.04, 0.04]
         let before = world();
         let dt = 2e-4;
         let mut cpu = before.clone();
-        crate::engine::cpu::motion::closing_kick(&mut cpu, dt);
+        crate::engine::cpu::motion::closing_kick(&mut cpu, dt, &mut Default::default());
         let mut kernel = before.clone();
         HostExecutor { block: 64 }.closing_kick(&mut kernel, dt);
         let (a, b) = (&cpu.particles, &kernel.particles);
