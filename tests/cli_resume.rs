@@ -144,8 +144,9 @@ fn a_run_killed_anywhere_and_resumed_gives_the_same_outputs() {
     let stdout = String::from_utf8_lossy(&run.stdout).to_string();
     finished(run);
     assert_eq!(rows(&whole), 102, "a header, t = 0 and 100 rows");
-    // Below the summary, the last step's contacts among its candidate pairs (those of
-    // summary.json) and each stage's share of the run, adding up to the whole.
+    // Below the summary, the last step's contacts, between particles among the
+    // candidate pairs and with walls (those of summary.json), and each stage's share
+    // of the run, adding up to the whole.
     let line = stdout
         .lines()
         .find_map(|l| l.trim().strip_prefix("last step: "))
@@ -156,10 +157,12 @@ fn a_run_killed_anywhere_and_resumed_gives_the_same_outputs() {
         serde_json::from_str(&std::fs::read_to_string(whole.join("summary.json")).unwrap())
             .unwrap();
     assert_eq!(words[0], summary["contacts"].to_string(), "{line}");
-    assert_eq!(words[3], summary["candidate_pairs"].to_string(), "{line}");
-    let (contacts, candidates): (usize, usize) =
-        (words[0].parse().unwrap(), words[3].parse().unwrap());
-    assert!(contacts > 0 && candidates >= contacts, "{line}");
+    assert_eq!(words[2], summary["pair_contacts"].to_string(), "{line}");
+    assert_eq!(words[6], summary["candidate_pairs"].to_string(), "{line}");
+    let number = |k: usize| -> usize { words[k].parse().unwrap() };
+    let (contacts, pairs, candidates, walls) = (number(0), number(2), number(6), number(10));
+    assert!(pairs > 0 && candidates >= pairs, "{line}");
+    assert_eq!(pairs + walls, contacts, "{line}");
     let shares: Vec<f64> = stages
         .split(", ")
         .map(|s| s.rsplit(' ').nth(1).unwrap().parse().unwrap())

@@ -92,6 +92,8 @@ pub struct Summary {
     pub frozen: usize,
     /// Contacts at the end.
     pub contacts: usize,
+    /// Of them between particles (the rest are with walls).
+    pub pair_contacts: usize,
     /// Candidate pairs of the neighbour list at the end (pairs whose bounding spheres,
     /// widened by the skin, overlap): what the narrow phase examined in the last step.
     /// It depends on where the list was last built, so a resumed run, which builds

@@ -364,9 +364,11 @@ fn run_loop(
         .map(|s| (s.stage.as_str(), s.share))
         .collect();
     println!(
-        "  last step: {} contacts of {} candidate pairs; stages: {}",
+        "  last step: {} contacts, {} between particles among {} candidate pairs and {} with walls; stages: {}",
         summary.contacts,
+        summary.pair_contacts,
         summary.candidate_pairs,
+        summary.contacts.saturating_sub(summary.pair_contacts),
         if stages.iter().any(|s| s.1 > 0.0) {
             crate::bench::stage_line(&stages)
         } else {
@@ -410,6 +412,7 @@ fn summary(
         particles: report.particles,
         frozen: sim.figures().frozen,
         contacts: report.contacts,
+        pair_contacts: sim.stats().pair_contacts,
         candidate_pairs: sim.stats().candidate_pairs,
         particle_steps_per_s: totals.particle_steps as f64 / elapsed,
         contacts_per_s: totals.contact_sum as f64 / elapsed,
