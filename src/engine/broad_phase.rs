@@ -53,6 +53,12 @@ impl GridLevel {
         c
     }
 
+    /// Positions in `sorted` of the particles in cell `cell`.
+    #[inline]
+    fn members(&self, cell: usize) -> std::ops::Range<usize> {
+        self.starts[cell] as usize..self.starts[cell + 1] as usize
+    }
+
     #[inline]
     fn index(&self, c: [usize; 3]) -> usize {
         (c[2] * self.dims[1] + c[1]) * self.dims[0] + c[0]
@@ -205,15 +211,12 @@ impl BroadPhase {
         };
         let c = grid.coords(&p, &self.origin);
         let cell = grid.index(c);
-        visit(grid, m + 1..grid.starts[cell + 1] as usize);
+        visit(grid, m + 1..grid.members(cell).end);
         for [dx, dy, dz] in FORWARD {
             let neighbour = [c[0] as isize + dx, c[1] as isize + dy, c[2] as isize + dz];
             if (0..3).all(|k| (0..grid.dims[k] as isize).contains(&neighbour[k])) {
                 let cell = grid.index(neighbour.map(|x| x as usize));
-                visit(
-                    grid,
-                    grid.starts[cell] as usize..grid.starts[cell + 1] as usize,
-                );
+                visit(grid, grid.members(cell));
             }
         }
         for grid in &self.levels[..own] {
@@ -223,10 +226,7 @@ impl BroadPhase {
                 for y in range(1) {
                     for x in range(0) {
                         let cell = grid.index([x, y, z]);
-                        visit(
-                            grid,
-                            grid.starts[cell] as usize..grid.starts[cell + 1] as usize,
-                        );
+                        visit(grid, grid.members(cell));
                     }
                 }
             }

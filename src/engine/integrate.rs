@@ -72,14 +72,14 @@ pub fn half_kick(state: &mut RotationState, torque: &Vector3<Real>, dt: Real) {
 
 /// Torque-free rotation over `dt` (see the module docs).
 pub fn free_rotation(state: &mut RotationState, inertia: &Vector3<Real>, dt: Real) {
+    if is_isotropic(inertia) {
+        turn_isotropic(state, 0.5 * dt / inertia.x);
+        return;
+    }
     if is_zero(&state.angular_momentum) {
         // A body without angular momentum does not turn: its orientation stays as
         // it is (normalised by its last turn). A poured particle falls so until its
         // first contact.
-        return;
-    }
-    if is_isotropic(inertia) {
-        turn_isotropic(state, 0.5 * dt / inertia.x);
         return;
     }
     let l0 = state

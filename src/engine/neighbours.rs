@@ -160,10 +160,10 @@ impl NeighbourList {
             (x - self.anchors[k]).norm_squared() >= pair_limit
                 || any_moved
                     && world.walls.iter().enumerate().any(|(w, wall)| {
-                        let local = wall.pose.inverse_transform_point(&x);
-                        moved(w)
-                            && (local - self.wall_anchors[k * walls + w]).norm_squared()
-                                >= wall_limit
+                        moved(w) && {
+                            let local = wall.pose.inverse_transform_point(&x);
+                            (local - self.wall_anchors[k * walls + w]).norm_squared() >= wall_limit
+                        }
                     })
         })
     }

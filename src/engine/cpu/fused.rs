@@ -8,7 +8,7 @@
 //! same order, so each particle gets the same additions in the same order (pairs
 //! apart included: they add zeros, as in the gather), and the totals are summed in
 //! pair order as the gather sums them. A run on one thread is therefore bit for bit
-//! a run on many (`tests/engine_step.rs`).
+//! a run on many (`tests/thread_count.rs`).
 //!
 //! # Why
 //! On one thread the results array is pure traffic: every pair's 88-byte result is
@@ -50,7 +50,6 @@ pub(super) fn pair_contacts_gathered(
     for k in 0..n {
         (force[k], torque[k], touching[k]) = start.of(k);
     }
-    let owned = p.owned();
     let with_plans = state.overlap_plans.len() == list.pairs().len();
     let mut spare = OverlapCache::default();
     let mut totals = ContactTotals::default();
@@ -63,7 +62,7 @@ pub(super) fn pair_contacts_gathered(
         let c = evaluate_pair(world, radii, &laws, pair, history, plan);
         for (particle, first) in [(pair[0] as usize, true), (pair[1] as usize, false)] {
             // A ghost's sums stay zero (the gather leaves them so).
-            if particle < owned {
+            if particle < start.owned {
                 c.add_to(
                     (
                         &mut force[particle],
