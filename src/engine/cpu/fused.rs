@@ -18,6 +18,7 @@
 
 use super::contact_state::ContactState;
 use super::pairs::{ContactTotals, PairLaws, StartLoads, evaluate_pair};
+use super::prefetch::PlanPrefetch;
 use crate::Real;
 use crate::engine::neighbours::NeighbourList;
 use crate::geometry::overlap::OverlapCache;
@@ -52,9 +53,11 @@ pub(super) fn pair_contacts_gathered(
     }
     let with_plans = state.overlap_plans.len() == list.pairs().len();
     let mut spare = OverlapCache::default();
+    let prefetch = PlanPrefetch::of(&state.overlap_plans);
     let mut totals = ContactTotals::default();
     for (k, (&pair, history)) in list.pairs().iter().zip(&mut state.pair_history).enumerate() {
         let plan = if with_plans {
+            prefetch.ahead(k);
             &mut state.overlap_plans[k]
         } else {
             &mut spare

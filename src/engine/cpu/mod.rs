@@ -26,6 +26,7 @@ mod hertz;
 pub(crate) mod motion;
 mod pairs;
 mod patch;
+mod prefetch;
 mod relative_motion;
 mod walls;
 

@@ -8,6 +8,7 @@ use super::contact_state::ContactState;
 use super::dispatch::pair_geometry;
 use super::forces::{ContactForce, PairResult, RelativeMotion, pair_force};
 use super::hertz::{HertzInputs, rolling_inertia, round_contact_force, round_radius, sphere_pair};
+use super::prefetch::PlanPrefetch;
 use crate::Real;
 use crate::contact::{RollingModel, TangentialHistory, effective_radius};
 use crate::engine::RoundLaw;
@@ -150,11 +151,16 @@ pub(super) fn pair_contacts(
     results.clear();
     let pairs = list.pairs().par_iter().zip(&mut state.pair_history);
     if state.overlap_plans.len() == list.pairs().len() {
+        let prefetch = PlanPrefetch::of(&state.overlap_plans);
         results.par_extend(
             pairs
                 .zip(&mut state.overlap_plans)
+                .enumerate()
                 .with_min_len(PAIRS_PER_TASK)
-                .map(|((&pair, history), plan)| evaluate(pair, history, plan)),
+                .map(|(k, ((&pair, history), plan))| {
+                    prefetch.ahead(k);
+                    evaluate(pair, history, plan)
+                }),
         );
     } else {
         // A world of spheres keeps no overlap plans (see `ContactState::rebuild`).

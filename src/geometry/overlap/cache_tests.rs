@@ -85,7 +85,7 @@ fn walk(
         let cached = overlap_cached_with(a, b, &pose, &mut cache, &mut scratch);
         let fresh = overlap(a, b, &pose);
         assert_eq!(bits(&cached), bits(&fresh), "step {k}");
-        let kept = kept_before == (cache.translation, cache.slack) && cache.slack.is_some();
+        let kept = kept_before == (cache.translation, cache.slack) && cache.slack.margin > 0.0;
         counts[if kept { 0 } else { 1 }] += 1;
         counts[2] += fresh.is_some() as usize;
         counts[3] += (fresh.is_some() && matches!(cache.decisions, Kept::Topology(_))) as usize;
@@ -102,12 +102,13 @@ fn kept_plans_answer_bit_for_bit() {
         for seed in 0..4 {
             let [kept, renewed, overlapping, by_topology] = walk(shape, shape, seed, 1e-8, 1e-6);
             // A slow walk keeps its plan most of the time, and renews it at the jumps
-            // and whenever a vertex comes near a plane.
+            // that come while the shapes overlap (a separation stands as long as its
+            // plane separates) and whenever a vertex comes near a plane.
             assert!(
                 kept > renewed,
                 "{name} {seed}: kept {kept}, renewed {renewed}"
             );
-            assert!(renewed >= 5, "{name} {seed}: renewed {renewed}");
+            assert!(renewed >= 2, "{name} {seed}: renewed {renewed}");
             assert!(
                 overlapping > 100,
                 "{name} {seed}: overlapping {overlapping}"
@@ -144,4 +145,41 @@ fn kept_plans_answer_bit_for_bit() {
         );
         assert!(cached.is_some());
     }
+}
+
+/// A separation is kept while one plane separates the shapes, however close other
+/// vertices come to other planes: two dodecahedra with a 1 mm gap across a face plane
+/// of one, jostled by up to 0.4 mm and 5 mrad in all, keep their first plan (and
+/// answer as a fresh overlap does), and renew it once the gap has closed.
+#[test]
+fn a_separation_stands_while_its_plane_separates() {
+    let d = generators::dodecahedron(0.005).unwrap();
+    let face = d.planes()[0];
+    let (gap, mut rng) = (1e-3, Pcg64::seed_from_u64(7));
+    // Every vertex of B lies within its circumradius of its centre: B's centre a
+    // circumradius and the gap beyond A's face plane leaves that plane separating.
+    let mut translation = face.normal * (face.offset + d.circumradius() + gap);
+    let mut rotation = UnitQuaternion::from_scaled_axis(small_vector(&mut rng, 3.0));
+    let mut cache = OverlapCache::default();
+    let mut renewed = 0;
+    for k in 0..200 {
+        let before = (cache.translation, cache.slack);
+        let pose = Isometry3::from_parts(Translation3::from(translation), rotation);
+        let cached = overlap_cached(&d, &d, &pose, &mut cache);
+        assert_eq!(bits(&cached), bits(&overlap(&d, &d, &pose)), "step {k}");
+        assert!(cached.is_none());
+        renewed += usize::from(before != (cache.translation, cache.slack));
+        translation += small_vector(&mut rng, 2e-6);
+        rotation = UnitQuaternion::from_scaled_axis(small_vector(&mut rng, 2.5e-5)) * rotation;
+    }
+    assert_eq!(
+        renewed, 1,
+        "a separation renewed {renewed} times in 200 steps"
+    );
+    // Closing the gap renews the plan, which finds the contact.
+    translation -= face.normal * 1.5 * gap;
+    let pose = Isometry3::from_parts(Translation3::from(translation), rotation);
+    let cached = overlap_cached(&d, &d, &pose, &mut cache);
+    assert_eq!(bits(&cached), bits(&overlap(&d, &d, &pose)));
+    assert!(cached.is_some());
 }

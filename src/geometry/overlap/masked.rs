@@ -111,6 +111,17 @@ impl Slack {
         per_lever: Real::INFINITY,
     };
 
+    /// Nothing kept: holds for no motion at all.
+    pub(super) const SPENT: Slack = Slack {
+        margin: 0.0,
+        per_lever: 0.0,
+    };
+
+    /// Whether some motion keeps every test as it was.
+    pub(super) fn is_kept(&self) -> bool {
+        self.margin > 0.0 && self.per_lever > 0.0
+    }
+
     /// The slack of both sets of tests.
     pub(super) fn min(self, other: Slack) -> Slack {
         Slack {
@@ -122,9 +133,7 @@ impl Slack {
     /// Whether a displacement `a` at the pivot and a turn `turn` leave every test
     /// as it was.
     pub(super) fn holds(&self, a: Real, turn: Real) -> bool {
-        self.margin > 0.0
-            && self.per_lever > 0.0
-            && a * self.per_lever + turn * self.margin < self.margin * self.per_lever
+        self.is_kept() && a * self.per_lever + turn * self.margin < self.margin * self.per_lever
     }
 }
 
@@ -201,15 +210,30 @@ fn plan_with_sets<M: VertexSet>(
         on_b,
     );
     let plan = &mut s.plan;
-    plan.slack = balls.min(masks_a).min(masks_b);
     plan.faces.clear();
     plan.of_a = 0;
     let side_a = MaskedSide::<M>::new(a, a.planes(), reached_a, &s.out_a, &s.on_a);
     let side_b = MaskedSide::<M>::new(b, &s.b_planes, reached_b, &s.out_b, &s.on_b);
     plan.separated = side_a.separated() || side_b.separated();
     if plan.separated {
+        // Separated is the one decision that matters: it stands while one separating
+        // plane keeps the other shape's vertices outside, whatever the other tests do.
+        let of_b = separating_slack(
+            a.vertex_soa(),
+            &s.inverse_lever_a,
+            &s.b_planes,
+            &side_a,
+            tol,
+        );
+        let of_a = separating_slack(&s.b_point_soa, &s.inverse_lever_b, a.planes(), &side_b, tol);
+        plan.slack = if of_a.margin >= of_b.margin {
+            of_a
+        } else {
+            of_b
+        };
         return;
     }
+    plan.slack = balls.min(masks_a).min(masks_b);
     // Faces of A clipped by B; flush pieces are kept apart.
     for f in bits(reached_a) {
         if let Some(cut) = face_cut(&side_a, &side_b, f) {
@@ -412,6 +436,40 @@ fn face_cut<M: VertexSet>(own: &MaskedSide<M>, other: &MaskedSide<M>, f: usize) 
         cut.planes |= (reaches as u64) << g;
     }
     Some(cut)
+}
+
+/// The slack of the separating plane of `planes` (those with every vertex of `side`
+/// outside, `points` its vertices) whose tests miss by the most: while that plane
+/// keeps every vertex more than `tol` outside, the shapes stay separated. No plane
+/// separates: no slack (zero margin).
+fn separating_slack<M: VertexSet>(
+    points: &PointSoa,
+    inverse_lever: &[Real],
+    planes: &[Plane],
+    side: &MaskedSide<M>,
+    tol: Real,
+) -> Slack {
+    let count = side.shape.vertices().len();
+    let mut best = Slack::SPENT;
+    for (k, p) in planes.iter().enumerate() {
+        if side.out(k) != side.all {
+            continue;
+        }
+        let slack = (0..count).fold(Slack::NONE, |slack, v| {
+            let d = p.normal.x * points.x[v] + p.normal.y * points.y[v] + p.normal.z * points.z[v]
+                - p.offset;
+            // Every vertex is outside: d > tol.
+            let miss = d - tol;
+            slack.min(Slack {
+                margin: miss,
+                per_lever: miss * inverse_lever[v],
+            })
+        });
+        if slack.margin > best.margin {
+            best = slack;
+        }
+    }
+    best
 }
 
 /// Planes (bits) whose outside the ball (`centre`, `radius`) reaches to within `tol`,

@@ -201,28 +201,41 @@ pub fn overlap_with(
 /// [`overlap_cached`] then answers bit for bit what [`overlap`] answers, skipping
 /// only the tests. Shapes beyond the bit-mask path, and plans of more faces than
 /// fit, are not kept.
+///
+/// The cache of every candidate pair is read each step, most of them apart: what a
+/// pair apart reads (the fields up to `decisions`' tag, 176 bytes) comes first and
+/// fills the first three cache lines, hence `repr(C)` and the alignment.
 #[derive(Clone, Debug)]
+#[repr(C, align(64))]
 pub struct OverlapCache {
     /// The two shapes the plan is for (addresses): a pair whose particles were
     /// replaced under the same list slot never uses another pair's plan.
     shapes: (usize, usize),
-    rotation: Matrix3<Real>,
+    /// The two shapes' figures the answer needs before the kept decisions, so that a
+    /// pair the cache answers reads neither shape while it stays apart.
+    figures: PairFigures,
+    /// How far the pair may move (see [`masked::Slack`]); [`masked::Slack::SPENT`]:
+    /// nothing kept.
+    slack: masked::Slack,
     translation: Vector3<Real>,
     /// The point of B (B's frame) that lay midway between the centroids, the pivot of
     /// `slack`.
     pivot_in_b: Vector3<Real>,
-    /// How far the pair may move (see [`masked::Slack`]); `None`: nothing kept.
-    slack: Option<masked::Slack>,
+    rotation: Matrix3<Real>,
+    decisions: Kept,
     /// B's vertices and planes (bits) that clipping by the plan, or evaluating the
     /// topology, reads: only these are placed in A's frame while the plan holds.
     b_vertices: u128,
     b_planes: u64,
-    decisions: Kept,
 }
+
+// A pair apart reads three cache lines.
+const _: () = assert!(OverlapCache::HOT_BYTES <= 3 * 64);
 
 /// What an [`OverlapCache`] keeps of a pose's decisions. One of them only: the cache
 /// of every candidate pair is read each step, and its size is memory traffic.
 #[derive(Clone, Debug)]
+#[repr(u8)]
 enum Kept {
     /// A face plane separates the shapes.
     Separated,
@@ -249,7 +262,8 @@ impl Default for OverlapCache {
             rotation: Matrix3::identity(),
             translation: Vector3::zeros(),
             pivot_in_b: Vector3::zeros(),
-            slack: None,
+            slack: masked::Slack::SPENT,
+            figures: PairFigures::default(),
             b_vertices: 0,
             b_planes: 0,
             decisions: Kept::Separated,
@@ -257,9 +271,36 @@ impl Default for OverlapCache {
     }
 }
 
+/// What the cached overlap of two shapes needs of them besides the kept decisions.
+#[derive(Clone, Copy, Debug, Default)]
+struct PairFigures {
+    /// The sum of the circumradii: centroids this far apart do not overlap.
+    reach: Real,
+    /// The coplanarity tolerance ([`tolerance`]).
+    tolerance: Real,
+}
+
+impl PairFigures {
+    fn of(a: &ConvexPolyhedron, b: &ConvexPolyhedron) -> Self {
+        PairFigures {
+            reach: a.circumradius() + b.circumradius(),
+            tolerance: tolerance(a, b),
+        }
+    }
+}
+
 impl OverlapCache {
+    /// The bytes at the start of a cache that a pair apart reads: up to the tag of
+    /// `decisions`.
+    pub const HOT_BYTES: usize = std::mem::offset_of!(OverlapCache, decisions) + 1;
+
+    /// The figures of the pair, where decisions are kept for these `shapes`.
+    fn kept_for(&self, shapes: (usize, usize)) -> Option<PairFigures> {
+        (self.slack.is_kept() && self.shapes == shapes).then_some(self.figures)
+    }
+
     /// Whether the kept decisions still hold at the pose (`rotation`, `translation`)
-    /// of B in A, for shapes whose overlap tolerance is `tol`.
+    /// of B in A (decisions kept for the pair's shapes: [`Self::kept_for`]).
     ///
     /// The relative motion since the kept pose moves B's material point at the pivot
     /// `c` (midway between the centroids then) by `a`, and any other by at most `a +
@@ -270,19 +311,9 @@ impl OverlapCache {
     /// the distances at the new pose. A plane–normal sign test between flush faces
     /// (the only other decision) cannot flip without a turn of order one radian, far
     /// beyond any slack.
-    fn holds(
-        &self,
-        shapes: (usize, usize),
-        rotation: &Matrix3<Real>,
-        translation: &Vector3<Real>,
-        tol: Real,
-    ) -> bool {
-        let Some(slack) = self.slack else {
-            return false;
-        };
-        if shapes != self.shapes {
-            return false;
-        }
+    fn holds(&self, rotation: &Matrix3<Real>, translation: &Vector3<Real>) -> bool {
+        let slack = self.slack;
+        let tol = self.figures.tolerance;
         let turn = (rotation - self.rotation).norm() * std::f64::consts::FRAC_1_SQRT_2;
         let pivot = 0.5 * self.translation;
         let a = (rotation * self.pivot_in_b + translation - pivot).norm();
@@ -302,12 +333,13 @@ impl OverlapCache {
         translation: Vector3<Real>,
         s: &mut OverlapScratch,
     ) {
-        self.slack = None;
+        self.slack = masked::Slack::SPENT;
         let plan = &s.plan;
         if plan.faces.len() > CACHED_FACES && topology.is_none() {
             return;
         }
         self.shapes = shapes;
+        self.figures = PairFigures::of(a, b);
         self.rotation = rotation;
         self.translation = translation;
         // The pivot, t/2, as a point of B.
@@ -332,7 +364,7 @@ impl OverlapCache {
                 }
             }
         };
-        self.slack = Some(slack);
+        self.slack = slack;
     }
 }
 
@@ -356,16 +388,21 @@ pub fn overlap_cached_with(
     cache: &mut OverlapCache,
     s: &mut OverlapScratch,
 ) -> Option<OverlapGeometry> {
-    if !(maskable(a) && maskable(b)) {
-        return overlap_with(a, b, b_in_a, s);
-    }
+    let shapes = (std::ptr::from_ref(a).addr(), std::ptr::from_ref(b).addr());
+    // A cache kept for these shapes knows their figures (and that both take the
+    // bit-mask path): a pair it answers apart reads neither shape.
+    let kept = cache.kept_for(shapes);
+    let figures = match kept {
+        Some(figures) => figures,
+        None if maskable(a) && maskable(b) => PairFigures::of(a, b),
+        None => return overlap_with(a, b, b_in_a, s),
+    };
     let t = b_in_a.translation.vector;
-    if t.norm() >= a.circumradius() + b.circumradius() {
+    if t.norm() >= figures.reach {
         return None;
     }
     let rotation = b_in_a.rotation.to_rotation_matrix().into_inner();
-    let shapes = (std::ptr::from_ref(a).addr(), std::ptr::from_ref(b).addr());
-    if cache.holds(shapes, &rotation, &t, tolerance(a, b)) {
+    if kept.is_some() && cache.holds(&rotation, &t) {
         // A kept separation needs not even B's vertices.
         if let Kept::Separated = cache.decisions {
             return None;
