@@ -148,7 +148,7 @@ pub struct OverlapScratch {
     /// The labelled clipping's double buffer, and edges of B near A (topology).
     labelled: [Vec<topology::LabelledVertex>; 2],
     labelled_distances: Vec<Real>,
-    near_edges: Vec<[u32; 2]>,
+    near_edges: Vec<topology::NearEdge>,
 }
 
 thread_local! {
