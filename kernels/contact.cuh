@@ -5,8 +5,16 @@
 
 #define HISTORY_DOUBLES 4u
 // A record of the energy sums (sums.cu): elastic energy, dissipated, wall contacts,
-// pair contacts.
-#define ENERGY_RECORD 4u
+// pair contacts, candidate pairs counted.
+#define ENERGY_RECORD 5u
+// A particle's role byte: frozen, a ghost (a copy of a particle another rank
+// owns), or both; nonzero where nobody here moves it (World's `is_passive`).
+#define FROZEN_ROLE 1u
+#define GHOST_ROLE 2u
+// A candidate pair's byte (spheres.cu): it touches; this world counts it in its
+// totals (Particles::counts_pair: every pair in one process).
+#define PAIR_TOUCHES 1u
+#define PAIR_COUNTED 2u
 #define RESULT_DOUBLES 9u
 // A pair's energy terms (spheres.cu): elastic energy, dissipated.
 #define PAIR_ENERGY_DOUBLES 2u

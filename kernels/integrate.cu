@@ -11,8 +11,9 @@
 //
 // Layout, as the host world holds it: per particle 3 doubles of position,
 // velocity, angular momentum, force and torque; the orientation as a unit
-// quaternion (i, j, k, w); its body type; frozen as a byte (0 or 1). Per body
-// type: the mass and the 3 principal moments of inertia.
+// quaternion (i, j, k, w); its body type; its role as a byte (contact.cuh's
+// roles: nonzero, frozen or a ghost, is not moved here). Per body type: the mass
+// and the 3 principal moments of inertia.
 
 // C^T v for the Cayley rotation of w: v turned back by the unit quaternion (1, w)/|.|.
 static __device__ __forceinline__ Vec3 cayley_transpose(Vec3 w, Vec3 v) {
@@ -59,10 +60,10 @@ static __device__ void free_rotation(Quat* q, Vec3* l, Vec3 inertia, double dt) 
 extern "C" __global__ void kick_drift(
     unsigned n, double dt, double* position, double* velocity, double* orientation,
     double* angular_momentum, const double* force, const double* torque,
-    const unsigned* body_type, const unsigned char* frozen, const double* mass,
+    const unsigned* body_type, const unsigned char* role, const double* mass,
     const double* inertia) {
     unsigned i = blockIdx.x * blockDim.x + threadIdx.x;
-    if (i >= n || frozen[i]) {
+    if (i >= n || role[i]) {
         return;
     }
     unsigned kind = body_type[i];
@@ -85,9 +86,9 @@ extern "C" __global__ void kick_drift(
 extern "C" __global__ void closing_kick(
     unsigned n, double dt, double* velocity, double* angular_momentum,
     const double* force, const double* torque, const unsigned* body_type,
-    const unsigned char* frozen, const double* mass) {
+    const unsigned char* role, const double* mass) {
     unsigned i = blockIdx.x * blockDim.x + threadIdx.x;
-    if (i >= n || frozen[i]) {
+    if (i >= n || role[i]) {
         return;
     }
     Vec3 v = add(load3(velocity, i), scale(load3(force, i), 0.5 * dt / mass[body_type[i]]));

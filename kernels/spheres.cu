@@ -8,15 +8,26 @@
 // coefficient; per pair its tangential history (spring, 3 doubles, and the stiffness it was stretched at)
 // and its result (force on the second particle, torque on the first and on the
 // second: 9 doubles), its energy terms (elastic energy, energy dissipated: apart
-// from the results, so that their sums read them in a row) and whether it touches.
+// from the results, so that their sums read them in a row; zero where this world
+// does not count the pair) and its byte (contact.cuh: touches, counted). Per
+// particle its role (contact.cuh: frozen, ghost).
+
+// Whether this world counts pair (i, j), i of the smaller id, in its totals
+// (world/particles.rs, Particles::counts_pair): where i is owned, unless i is
+// frozen and j a ghost; where i is a ghost, if i is frozen and j owned.
+static __device__ __forceinline__ bool counts_pair(unsigned char ri, unsigned char rj) {
+    bool frozen_i = (ri & FROZEN_ROLE) != 0;
+    bool ghost_i = (ri & GHOST_ROLE) != 0, ghost_j = (rj & GHOST_ROLE) != 0;
+    return ghost_i ? frozen_i && !ghost_j : !(frozen_i && ghost_j);
+}
 
 // One thread per candidate pair: its contact, if the spheres overlap and one of
-// them moves, into its result; its history replaced by what the contact leaves
-// (none when apart).
+// them moves here (is neither frozen nor a ghost), into its result; its history
+// replaced by what the contact leaves (none when apart).
 extern "C" __global__ void sphere_contacts(
     unsigned pair_count, double dt, const unsigned* pairs, const double* position,
     const double* velocity, const double* angular_momentum, const unsigned* body_type,
-    const unsigned char* frozen, const double* type_radius, const double* type_inverse_mass,
+    const unsigned char* role, const double* type_radius, const double* type_inverse_mass,
     const double* type_inverse_inertia, const unsigned* type_material, unsigned materials,
     const double* material_pairs, double* history, double* results, double* energies,
     unsigned char* touching) {
@@ -25,6 +36,8 @@ extern "C" __global__ void sphere_contacts(
         return;
     }
     unsigned i = pairs[2 * e], j = pairs[2 * e + 1];
+    bool counted = counts_pair(role[i], role[j]);
+    unsigned char counted_flag = counted ? PAIR_COUNTED : 0u;
     unsigned ti = body_type[i], tj = body_type[j];
     double ra = type_radius[ti], rb = type_radius[tj];
     Spring before = Spring{load3(history + HISTORY_DOUBLES * e, 0),
@@ -35,7 +48,7 @@ extern "C" __global__ void sphere_contacts(
     Vec3 d = sub(xj, xi);
     double distance_squared = norm_squared(d);
     double reach = ra + rb;
-    bool contact = !(frozen[i] && frozen[j]) && distance_squared < reach * reach &&
+    bool contact = !(role[i] && role[j]) && distance_squared < reach * reach &&
                    distance_squared != 0.0;
     if (!contact) {
         bool held = before.spring.x != 0.0 || before.spring.y != 0.0 || before.spring.z != 0.0;
@@ -44,10 +57,10 @@ extern "C" __global__ void sphere_contacts(
         }
         energy[0] = 0.0;
         energy[1] = 0.0;
-        touching[e] = 0;
+        touching[e] = counted_flag;
         if (held) {
             // The friction spring's energy is let go with the contact.
-            energy[1] = spring_energy(before);
+            energy[1] = counted ? spring_energy(before) : 0.0;
             for (unsigned k = 0; k < HISTORY_DOUBLES; ++k) {
                 history[HISTORY_DOUBLES * e + k] = 0.0;
             }
@@ -75,9 +88,9 @@ extern "C" __global__ void sphere_contacts(
     store3(result, 0, force);
     store3(result, 1, reaction);
     store3(result, 2, torque);
-    energy[0] = c.energy;
-    energy[1] = c.dissipated;
-    touching[e] = 1;
+    energy[0] = counted ? c.energy : 0.0;
+    energy[1] = counted ? c.dissipated : 0.0;
+    touching[e] = PAIR_TOUCHES | counted_flag;
     history[HISTORY_DOUBLES * e] = kept.spring.x;
     history[HISTORY_DOUBLES * e + 1] = kept.spring.y;
     history[HISTORY_DOUBLES * e + 2] = kept.spring.z;
@@ -85,26 +98,34 @@ extern "C" __global__ void sphere_contacts(
 }
 
 // One thread per particle: its weight plus its pairs' forces in pair order (its
-// partners in the order of their ids), and the torques; whether it touches.
+// partners in the order of their ids), and the torques; whether it touches (a
+// frozen one does). A ghost gets no force, no torque and does not touch
+// (engine/cpu/pairs.rs, StartLoads).
 extern "C" __global__ void gather_forces(
     unsigned n, double gx, double gy, double gz, const unsigned* body_type,
-    const double* type_mass, const unsigned char* frozen, const unsigned* incident_starts,
+    const double* type_mass, const unsigned char* role, const unsigned* incident_starts,
     const unsigned* incident, const double* results, const unsigned char* pair_touching,
     double* force, double* torque, unsigned char* touching) {
     unsigned k = blockIdx.x * blockDim.x + threadIdx.x;
     if (k >= n) {
         return;
     }
-    Vec3 f = scale(Vec3{gx, gy, gz}, type_mass[body_type[k]]);
     Vec3 t = Vec3{0.0, 0.0, 0.0};
-    unsigned char touches = frozen[k];
+    if (role[k] & GHOST_ROLE) {
+        store3(force, k, t);
+        store3(torque, k, t);
+        touching[k] = 0;
+        return;
+    }
+    unsigned char touches = role[k] & FROZEN_ROLE;
+    Vec3 f = scale(Vec3{gx, gy, gz}, type_mass[body_type[k]]);
     for (unsigned s = incident_starts[k]; s < incident_starts[k + 1]; ++s) {
         unsigned entry = incident[s];
         unsigned e = entry & 0x7fffffffu;
         bool first = (entry & 0x80000000u) != 0;
         const double* c = results + RESULT_DOUBLES * e;
         double sign = first ? -1.0 : 1.0;
-        touches |= pair_touching[e];
+        touches |= pair_touching[e] & PAIR_TOUCHES;
         f = add(f, scale(load3(c, 0), sign));
         t = add(t, load3(c, first ? 1 : 2));
     }

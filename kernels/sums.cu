@@ -41,8 +41,9 @@ extern "C" __global__ void sum_records(unsigned count, unsigned width, const dou
 
 // The first pass over the pairs' energy terms (spheres.cu): thread t of `groups`
 // sums the elastic energy and the dissipation of pairs t, t + groups, … into record
-// t of `records` (ENERGY_RECORD doubles: energy, dissipated, wall contacts = 0, and
-// the pairs that touch, counted exactly).
+// t of `records` (ENERGY_RECORD doubles: energy, dissipated, wall contacts = 0, the
+// pairs that touch and the candidate pairs, both of those this world counts,
+// counted exactly).
 extern "C" __global__ void pair_energy_partials(unsigned pair_count, const double* energies,
                                                 const unsigned char* touching,
                                                 unsigned groups, double* records) {
@@ -56,9 +57,11 @@ extern "C" __global__ void pair_energy_partials(unsigned pair_count, const doubl
     records[ENERGY_RECORD * t] = strided_sum(energies + first, end, step);
     records[ENERGY_RECORD * t + 1] = strided_sum(energies + first + 1, end, step);
     records[ENERGY_RECORD * t + 2] = 0.0;
-    unsigned touches = 0;
+    unsigned touches = 0, counted = 0;
     for (unsigned e = t; e < pair_count; e += groups) {
-        touches += touching[e];
+        touches += touching[e] == (PAIR_TOUCHES | PAIR_COUNTED);
+        counted += (touching[e] & PAIR_COUNTED) != 0;
     }
     records[ENERGY_RECORD * t + 3] = (double)touches;
+    records[ENERGY_RECORD * t + 4] = (double)counted;
 }

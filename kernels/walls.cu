@@ -98,12 +98,13 @@ static __device__ __forceinline__ void plane_key(Vec3 n, Vec3 point, double radi
     key[3] = (long long)round(dot(n, point) / radius * 1e9);
 }
 
-// One thread per particle: its wall contacts (see the file's head). `overflow`
-// is set when a particle has more than WALL_SLOTS contacts.
+// One thread per particle: its wall contacts (see the file's head), none for a
+// passive one (frozen or a ghost). `overflow` is set when a particle has more
+// than WALL_SLOTS contacts.
 extern "C" __global__ void sphere_walls(
     unsigned n, double dt, const double* position, const double* velocity,
     const double* orientation, const double* angular_momentum, const unsigned* body_type,
-    const unsigned char* frozen, const double* type_radius, const double* type_mass,
+    const unsigned char* role, const double* type_radius, const double* type_mass,
     const double* type_inertia, const unsigned* type_material, unsigned materials,
     const double* material_pairs, unsigned walls, const unsigned* wall_facets,
     const double* facets, const double* facet_normals, const unsigned* wall_material,
@@ -116,7 +117,7 @@ extern "C" __global__ void sphere_walls(
         return;
     }
     count[i] = 0;
-    if (frozen[i]) {
+    if (role[i]) {
         return;
     }
     unsigned kind = body_type[i];
@@ -334,4 +335,5 @@ extern "C" __global__ void wall_energy_terms(unsigned n, const unsigned* count,
     record[1] = dissipated;
     record[2] = (double)count[i];
     record[3] = 0.0;
+    record[4] = 0.0;
 }

@@ -19,8 +19,10 @@ use super::readback::{self, Readback};
 use crate::Real;
 
 /// Doubles of a row of the energy sums: elastic energy, dissipated energy, wall
-/// contacts, pair contacts (`ENERGY_RECORD` in `kernels/contact.cuh`).
-pub(super) const ENERGY_RECORD: usize = 4;
+/// contacts, pair contacts, candidate pairs (`ENERGY_RECORD` in
+/// `kernels/contact.cuh`). The pairs' terms are those the world counts (all of
+/// them in one process; see `Particles::counts_pair`).
+pub(super) const ENERGY_RECORD: usize = 5;
 
 /// The rows a thread of a pass folds into one, at most.
 const FAN_IN: usize = 32;
@@ -121,7 +123,8 @@ pub(super) struct PairTerms<'a> {
 
 /// Sums the elastic energy and dissipation of the `pairs` and of the wall contacts
 /// of `walls` for `n` particles into the readback's sums (elastic energy,
-/// dissipated energy, wall contacts, pair contacts), by the scratch `sums`.
+/// dissipated energy, wall contacts, pair contacts, candidate pairs), by the
+/// scratch `sums`.
 pub(super) fn sum_energies(
     sums: &mut RowSums,
     device: &mut dyn Device,

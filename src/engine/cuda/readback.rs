@@ -5,9 +5,9 @@
 //! # Layout (doubles)
 //! - `[0]`: the walls' overflow flag, a 32-bit word in the double's first bytes
 //!   (`sphere_walls` sets it by `atomicOr`; zeroed before each evaluation);
-//! - `[1..5]`: the contacts' sums (elastic energy, dissipated, wall contacts, pair
-//!   contacts: `device_sums.rs`);
-//! - `[5..]`: per wall its force and torque, then per facet its force
+//! - `[1..6]`: the contacts' sums (elastic energy, dissipated, wall contacts, pair
+//!   contacts, candidate pairs: `device_sums.rs`);
+//! - `[6..]`: per wall its force and torque, then per facet its force
 //!   (`device_walls.rs`).
 
 use super::Kernel;

@@ -13,9 +13,15 @@
 //! particle's wall contacts follow its pairs' gather. The walls' forces and the
 //! contacts' energies are summed in a fixed tree (`device_sums.rs`).
 //!
+//! The device holds the particles in the order of their ids, whatever the host's
+//! order (the list and the gather meet a particle's partners in that order, as the
+//! CPU backend's sorted lists do); `order` maps each device slot to its host entry.
+//! A rank's share of a decomposed world steps as the CPU backend steps it: ghosts
+//! are felt and not moved, get no force and no wall contacts, and the figures
+//! count the pairs the rank counts (`Particles::counts_pair`).
+//!
 //! What it does not take yet (refused by [`DeviceSpheres::new`]): polyhedra,
-//! rolling resistance, a fluid, ghosts of a decomposition, particles not stored in
-//! the order of their ids.
+//! rolling resistance, a fluid.
 
 use nalgebra::{Point3, UnitQuaternion, Vector3};
 
@@ -31,7 +37,7 @@ use crate::Real;
 use crate::contact::{RollingModel, pair_restitution};
 use crate::engine::neighbours::automatic_skin;
 use crate::engine::{RoundLaw, StepParams};
-use crate::world::World;
+use crate::world::{Particles, World};
 
 /// Doubles of a pair's tangential history on the device: the spring and the
 /// stiffness it was stretched at.
@@ -40,6 +46,9 @@ const HISTORY: usize = 4;
 const RESULT: usize = 9;
 /// Doubles of a pair's energy terms (`kernels/spheres.cu`).
 const PAIR_ENERGY: usize = 2;
+/// A particle's role byte (`kernels/contact.cuh`): frozen, a ghost, or both.
+const FROZEN_ROLE: u8 = 1;
+const GHOST_ROLE: u8 = 2;
 
 /// Why a world cannot be stepped on the device.
 #[derive(Debug, thiserror::Error)]
@@ -66,8 +75,9 @@ struct TypeArrays {
     materials: u32,
 }
 
-/// The particles' state on the device (nalgebra's layouts: 3 doubles per point or
-/// vector, a quaternion as i, j, k, w; frozen as a byte).
+/// The particles' state on the device, in the order of their ids (nalgebra's
+/// layouts: 3 doubles per point or vector, a quaternion as i, j, k, w; the role as
+/// a byte).
 #[derive(Debug, Default)]
 struct ParticleArrays {
     position: Array<Real>,
@@ -77,7 +87,8 @@ struct ParticleArrays {
     force: Array<Real>,
     torque: Array<Real>,
     body_type: Array<u32>,
-    frozen: Array<u8>,
+    /// Frozen, a ghost, or both: nonzero where nobody here moves the particle.
+    role: Array<u8>,
     id: Array<u64>,
     touching: Array<u8>,
 }
@@ -98,6 +109,8 @@ struct PairArrays {
 pub struct DeviceSpheres {
     device: Box<dyn Device>,
     n: usize,
+    /// The host world's entry of each device slot: the entries in id order.
+    order: Vec<usize>,
     gravity: Vector3<Real>,
     time: Real,
     types: TypeArrays,
@@ -128,9 +141,27 @@ fn quaternions(q: &[UnitQuaternion<Real>]) -> Vec<Real> {
     flat(q.iter().map(|q| q.coords.into()))
 }
 
-/// Flags as bytes.
-fn bytes(flags: &[bool]) -> Vec<u8> {
-    flags.iter().map(|&f| u8::from(f)).collect()
+/// The host world's entries in the order of their ids.
+fn id_order(p: &Particles) -> Vec<usize> {
+    let mut order: Vec<usize> = (0..p.len()).collect();
+    if !p.id.is_sorted() {
+        order.sort_unstable_by_key(|&i| p.id[i]);
+    }
+    order
+}
+
+/// `values` of the host entries `order`.
+fn in_order<T: Copy>(values: &[T], order: &[usize]) -> Vec<T> {
+    order.iter().map(|&i| values[i]).collect()
+}
+
+/// The role bytes of the host entries `order`.
+fn roles(p: &Particles, order: &[usize]) -> Vec<u8> {
+    let role = |i: usize| {
+        let ghost = if p.is_ghost(i) { GHOST_ROLE } else { 0 };
+        ghost | if p.frozen[i] { FROZEN_ROLE } else { 0 }
+    };
+    order.iter().map(|&i| role(i)).collect()
 }
 
 impl DeviceSpheres {
@@ -198,6 +229,7 @@ impl DeviceSpheres {
         let mut spheres = DeviceSpheres {
             device,
             n: p.len(),
+            order: id_order(p),
             gravity: world.gravity,
             time: world.time,
             types,
@@ -226,13 +258,6 @@ impl DeviceSpheres {
         if world.fluid.is_some() {
             return unsupported("a fluid");
         }
-        let p = &world.particles;
-        if p.ghosts() > 0 {
-            return unsupported("a rank's share of a decomposed world");
-        }
-        if !p.id.is_sorted() {
-            return unsupported("particles out of the order of their ids");
-        }
         if world
             .body_types
             .iter()
@@ -243,18 +268,23 @@ impl DeviceSpheres {
         Ok(())
     }
 
-    /// Copies the particles' state to the device.
+    /// Copies the particles' state to the device, in the order of `self.order`.
     fn upload_particles(&mut self, world: &World) -> Result<(), DeviceError> {
         let (d, a, p) = (self.device.as_mut(), &mut self.particles, &world.particles);
-        a.position.write(d, &points(&p.position))?;
-        a.velocity.write(d, &vectors(&p.velocity))?;
-        a.orientation.write(d, &quaternions(&p.orientation))?;
-        a.angular_momentum.write(d, &vectors(&p.angular_momentum))?;
-        a.force.write(d, &vectors(&p.force))?;
-        a.torque.write(d, &vectors(&p.torque))?;
-        a.body_type.write(d, &p.body_type)?;
-        a.frozen.write(d, &bytes(&p.frozen))?;
-        a.id.write(d, &p.id)?;
+        let order = &self.order;
+        a.position
+            .write(d, &points(&in_order(&p.position, order)))?;
+        a.velocity
+            .write(d, &vectors(&in_order(&p.velocity, order)))?;
+        a.orientation
+            .write(d, &quaternions(&in_order(&p.orientation, order)))?;
+        a.angular_momentum
+            .write(d, &vectors(&in_order(&p.angular_momentum, order)))?;
+        a.force.write(d, &vectors(&in_order(&p.force, order)))?;
+        a.torque.write(d, &vectors(&in_order(&p.torque, order)))?;
+        a.body_type.write(d, &in_order(&p.body_type, order))?;
+        a.role.write(d, &roles(p, order))?;
+        a.id.write(d, &in_order(&p.id, order))?;
         a.touching.resize(d, p.len())?;
         self.list.invalidate();
         Ok(())
@@ -311,7 +341,7 @@ impl DeviceSpheres {
                     p.force.arg(),
                     p.torque.arg(),
                     p.body_type.arg(),
-                    p.frozen.arg(),
+                    p.role.arg(),
                     t.mass.arg(),
                     t.inertia.arg(),
                 ],
@@ -335,7 +365,7 @@ impl DeviceSpheres {
                     p.force.arg(),
                     p.torque.arg(),
                     p.body_type.arg(),
-                    p.frozen.arg(),
+                    p.role.arg(),
                     t.mass.arg(),
                 ],
             )
@@ -407,7 +437,7 @@ impl DeviceSpheres {
                     p.velocity.arg(),
                     p.angular_momentum.arg(),
                     p.body_type.arg(),
-                    p.frozen.arg(),
+                    p.role.arg(),
                     t.radius.arg(),
                     t.inverse_mass.arg(),
                     t.inverse_inertia.arg(),
@@ -432,7 +462,7 @@ impl DeviceSpheres {
                     Arg::F64(g.z),
                     p.body_type.arg(),
                     t.mass.arg(),
-                    p.frozen.arg(),
+                    p.role.arg(),
                     list.incident_starts.arg(),
                     list.incident.arg(),
                     pairs.results.arg(),
@@ -452,7 +482,7 @@ impl DeviceSpheres {
                 orientation: &p.orientation,
                 angular_momentum: &p.angular_momentum,
                 body_type: &p.body_type,
-                frozen: &p.frozen,
+                role: &p.role,
                 type_radius: &t.radius,
                 type_mass: &t.mass,
                 type_inertia: &t.inertia,

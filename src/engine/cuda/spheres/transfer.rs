@@ -4,7 +4,7 @@
 
 use nalgebra::{Point3, Quaternion, UnitQuaternion, Vector3};
 
-use super::{DeviceSpheres, HISTORY, bytes, points, quaternions, vectors};
+use super::{DeviceSpheres, HISTORY, in_order, points, quaternions, roles, vectors};
 use crate::Real;
 use crate::contact::TangentialHistory;
 use crate::engine::backend::ContactHistory;
@@ -36,7 +36,7 @@ impl DeviceSpheres {
             &q.results,
             &q.terms,
         ];
-        let bytes = [&p.frozen, &p.touching, &q.touching];
+        let bytes = [&p.role, &p.touching, &q.touching];
         doubles.iter().map(|a| a.bytes(d)).sum::<usize>()
             + bytes.iter().map(|a| a.bytes(d)).sum::<usize>()
             + [&p.body_type, &t.material]
@@ -61,14 +61,15 @@ impl DeviceSpheres {
 
     /// The figures of the last force evaluation: contacts (pairs and walls), the
     /// pairs', candidate pairs, elastic energy and dissipation, list builds (of
-    /// the evaluation's read-back).
+    /// the evaluation's read-back; the pairs' figures of those the world counts,
+    /// see `Particles::counts_pair`).
     pub fn stats(&self) -> crate::engine::StepStats {
         let e = self.readback.sums();
         let pair_contacts = e[3] as usize;
         crate::engine::StepStats {
             contacts: pair_contacts + e[2] as usize,
             pair_contacts,
-            candidate_pairs: self.list.pair_count,
+            candidate_pairs: e[4] as usize,
             integrated: 0,
             elastic_energy: e[0],
             dissipated: e[1],
@@ -104,13 +105,15 @@ impl DeviceSpheres {
     }
 
     /// Takes the particles appended to `world` since the stepper saw it last (an
-    /// inlet's: their ids above every other, the host world up to date): their
+    /// inlet's: after every other entry, their ids above every other, the host
+    /// world up to date): their
     /// state goes after the others' (the arrays uploaded whole only where a buffer
     /// has no room left), they start without wall contacts, and the list is built
     /// again at the next evaluation, the pairs' history carried by their ids.
     pub fn append(&mut self, world: &World) -> Result<(), DeviceError> {
         let p = &world.particles;
         let (from, n) = (self.n, p.len());
+        self.order.extend(from..n);
         let (d, a) = (self.device.as_mut(), &mut self.particles);
         grow(d, &mut a.position, from, n, |r| points(&p.position[r]))?;
         grow(d, &mut a.velocity, from, n, |r| vectors(&p.velocity[r]))?;
@@ -123,7 +126,9 @@ impl DeviceSpheres {
         grow(d, &mut a.force, from, n, |r| vectors(&p.force[r]))?;
         grow(d, &mut a.torque, from, n, |r| vectors(&p.torque[r]))?;
         grow(d, &mut a.body_type, from, n, |r| p.body_type[r].to_vec())?;
-        grow(d, &mut a.frozen, from, n, |r| bytes(&p.frozen[r]))?;
+        grow(d, &mut a.role, from, n, |r| {
+            roles(p, &r.collect::<Vec<_>>())
+        })?;
         grow(d, &mut a.id, from, n, |r| p.id[r].to_vec())?;
         a.touching.resize(d, n)?;
         self.walls.grow(d, n)?;
@@ -137,9 +142,12 @@ impl DeviceSpheres {
     /// stays (pairs of frozen particles drop out of the contacts, not the list).
     pub fn motion_from_host(&mut self, world: &World) -> Result<(), DeviceError> {
         let (d, a, p) = (self.device.as_mut(), &mut self.particles, &world.particles);
-        a.frozen.write(d, &bytes(&p.frozen))?;
-        a.velocity.write(d, &vectors(&p.velocity))?;
-        a.angular_momentum.write(d, &vectors(&p.angular_momentum))
+        let order = &self.order;
+        a.role.write(d, &roles(p, order))?;
+        a.velocity
+            .write(d, &vectors(&in_order(&p.velocity, order)))?;
+        a.angular_momentum
+            .write(d, &vectors(&in_order(&p.angular_momentum, order)))
     }
 
     /// Takes the walls' poses, velocities and motions from `world` (moved by the
@@ -169,38 +177,42 @@ impl DeviceSpheres {
         Ok(())
     }
 
-    /// Copies the particles' state and forces into `world`.
+    /// Copies the particles' state and forces into `world` (which holds the
+    /// stepper's particles at their host entries).
     pub fn particles_to_host(&self, world: &mut World) -> Result<(), DeviceError> {
         let (d, a) = (self.device.as_ref(), &self.particles);
         let p = &mut world.particles;
-        let vectors = |x: &Array<Real>| -> Result<Vec<Vector3<Real>>, DeviceError> {
-            Ok(x.read(d)?
-                .chunks_exact(3)
-                .map(Vector3::from_column_slice)
-                .collect())
+        let order = &self.order;
+        let vectors = |x: &Array<Real>, into: &mut [Vector3<Real>]| -> Result<(), DeviceError> {
+            let values = x.read(d)?;
+            for (&i, v) in order.iter().zip(values.chunks_exact(3)) {
+                into[i] = Vector3::from_column_slice(v);
+            }
+            Ok(())
         };
-        p.position = vectors(&a.position)?
-            .into_iter()
-            .map(Point3::from)
-            .collect();
-        p.velocity = vectors(&a.velocity)?;
-        p.angular_momentum = vectors(&a.angular_momentum)?;
-        p.force = vectors(&a.force)?;
-        p.torque = vectors(&a.torque)?;
-        p.orientation = a
-            .orientation
-            .read(d)?
-            .chunks_exact(4)
-            .map(|q| UnitQuaternion::new_unchecked(Quaternion::new(q[3], q[0], q[1], q[2])))
-            .collect();
+        vectors(&a.velocity, &mut p.velocity)?;
+        vectors(&a.angular_momentum, &mut p.angular_momentum)?;
+        vectors(&a.force, &mut p.force)?;
+        vectors(&a.torque, &mut p.torque)?;
+        for (&i, x) in order.iter().zip(a.position.read(d)?.chunks_exact(3)) {
+            p.position[i] = Point3::new(x[0], x[1], x[2]);
+        }
+        for (&i, q) in order.iter().zip(a.orientation.read(d)?.chunks_exact(4)) {
+            p.orientation[i] =
+                UnitQuaternion::new_unchecked(Quaternion::new(q[3], q[0], q[1], q[2]));
+        }
         Ok(())
     }
 
-    /// Whether each particle touched another at the last force evaluation (frozen
-    /// ones count as touching).
+    /// Whether each particle (in the host world's order) touched another at the
+    /// last force evaluation (frozen ones count as touching).
     pub fn touching(&self) -> Result<Vec<bool>, DeviceError> {
         let flags = self.particles.touching.read(self.device.as_ref())?;
-        Ok(flags.into_iter().map(|t| t != 0).collect())
+        let mut touching = vec![false; flags.len()];
+        for (&i, t) in self.order.iter().zip(flags) {
+            touching[i] = t != 0;
+        }
+        Ok(touching)
     }
 
     /// The pairs' tangential history, sorted by the particles' ids (pairs apart,
