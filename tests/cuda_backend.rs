@@ -15,42 +15,8 @@ use talus::engine::cuda::device::HostDevice;
 use talus::engine::{Backend, CpuBackend};
 use talus::scene::{Scene, Simulation};
 
-const POUR: &str = r#"
-[simulation]
-dt = 2e-5
-end_time = 1.0
-gravity = [0.0, 0.0, -9.81]
-seed = 3
-[contact]
-law = "hertz_mindlin"
-[materials.glass]
-density = 2500.0
-young = 1e7
-poisson = 0.3
-restitution = 0.5
-friction = 0.5
-[shapes.bead]
-kind = "sphere"
-radius = 0.004
-[[wall]]
-name = "box"
-material = "glass"
-geometry = { kind = "box", min = [0.0, 0.0, 0.0], max = [0.05, 0.05, 0.2], open_top = true }
-[[inlet]]
-shape = "bead"
-material = "glass"
-min = [0.005, 0.005, 0.01]
-max = [0.045, 0.045, 0.06]
-rate = 20000.0
-count = 120
-velocity = [0.0, 0.0, -1.0]
-[[particles]]
-kind = "lattice"
-shape = "bead"
-material = "glass"
-min = [0.0, 0.0, 0.0]
-max = [0.05, 0.05, 0.02]
-"#;
+/// 120 beads poured onto 72 in an open box.
+const POUR: &str = include_str!("scenes/sphere_pour.toml");
 
 /// 2000 steps: the particles and the step's figures equal the CPU backend's at
 /// every hundredth step, and the box's force, torque and facet forces and the

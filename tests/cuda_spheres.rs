@@ -10,7 +10,7 @@
 use std::path::Path;
 
 mod common;
-use common::{close, near};
+use common::{GLASS_AND_STEEL_SPHERES, close, near};
 
 use nalgebra::{Point3, UnitQuaternion, Vector3};
 use rand::{Rng, SeedableRng};
@@ -22,31 +22,8 @@ use talus::engine::{Backend, CpuBackend, StepParams};
 use talus::scene::Scene;
 use talus::world::World;
 
-const SCENE: &str = r#"
-[simulation]
-dt = 2e-5
-end_time = 1.0
-gravity = [0.0, 0.0, -9.81]
-[contact]
-law = "hertz_mindlin"
-[materials.glass]
-density = 2500.0
-young = 1e7
-poisson = 0.3
-restitution = 0.5
-friction = 0.5
-[materials.steel]
-density = 7800.0
-young = 2e7
-poisson = 0.25
-restitution = 0.7
-friction = 0.3
-[shapes.big]
-kind = "sphere"
-radius = 0.005
-[shapes.small]
-kind = "sphere"
-radius = 0.004
+/// The cloud's two lattices (after `GLASS_AND_STEEL_SPHERES`).
+const LATTICES: &str = r#"
 [[particles]]
 kind = "lattice"
 shape = "big"
@@ -80,7 +57,11 @@ fn cloud() -> (World, StepParams) {
 /// The cloud with `walls` (scene text) added, its spheres moving at `spread` times
 /// their position (negative: converging) plus a random velocity.
 fn cloud_in(walls: &str, spread: f64) -> (World, StepParams) {
-    let scene = Scene::parse(&format!("{SCENE}{walls}"), Path::new("cloud.toml")).unwrap();
+    let scene = Scene::parse(
+        &format!("{GLASS_AND_STEEL_SPHERES}{LATTICES}{walls}"),
+        Path::new("cloud.toml"),
+    )
+    .unwrap();
     let params = scene.step_params();
     let mut world = scene.world;
     assert_eq!(world.body_types.len(), 2);
@@ -500,7 +481,11 @@ name = "box"
 material = "glass"
 geometry = { kind = "box", min = [-0.0039, -0.0039, 0.0], max = [0.0039, 0.0039, 0.02], open_top = true }
 "#;
-    let scene = Scene::parse(&format!("{SCENE}{walls}"), Path::new("wedged.toml")).unwrap();
+    let scene = Scene::parse(
+        &format!("{GLASS_AND_STEEL_SPHERES}{LATTICES}{walls}"),
+        Path::new("wedged.toml"),
+    )
+    .unwrap();
     let params = scene.step_params();
     let mut world = scene.world;
     world.particles = Default::default();
@@ -521,4 +506,25 @@ geometry = { kind = "box", min = [-0.0039, -0.0039, 0.0], max = [0.0039, 0.0039,
     let mut spheres = DeviceSpheres::new(host(64), &world, &params).unwrap();
     spheres.initialise(2e-5).unwrap();
     assert_eq!(spheres.stats().contacts, 4);
+}
+
+/// A history set on a new stepper is its history until a build carries it into
+/// the list (a rank renews its share and reads the history before the next
+/// evaluation): read back as set, pairs and wall patches.
+#[test]
+fn a_history_set_is_read_back_before_the_next_build() {
+    let (start, params) = cloud_in(OPEN_BOX, 30.0);
+    let dt = 2e-5;
+    let mut spheres = DeviceSpheres::new(host(64), &start, &params).unwrap();
+    spheres.initialise(dt).unwrap();
+    for _ in 0..300 {
+        spheres.step(dt).unwrap();
+    }
+    let history = spheres.contact_history().unwrap();
+    assert!(history.pairs.len() > 20 && !history.walls.is_empty());
+    let mut world = start.clone();
+    spheres.download(&mut world).unwrap();
+    let mut again = DeviceSpheres::new(host(64), &world, &params).unwrap();
+    again.set_history(&history).unwrap();
+    assert_eq!(again.contact_history().unwrap(), history);
 }

@@ -12,6 +12,9 @@
 use std::path::Path;
 use std::process::{Command, ExitCode};
 
+mod common;
+use common::mpirun_self;
+
 use nalgebra::Vector3;
 use rand::{Rng, SeedableRng};
 use talus::Real;
@@ -55,17 +58,8 @@ fn main() -> ExitCode {
 
 /// Runs this program under `mpirun -np 1…4` and reads rank 0's report of each run.
 fn launch_ranks() -> Result<(), String> {
-    let program = std::env::current_exe().map_err(|e| e.to_string())?;
     for ranks in 1..=4 {
-        let out = Command::new("mpirun")
-            .args(["--oversubscribe", "-np", &ranks.to_string()])
-            .arg(&program)
-            .env(RANK_MARK, "1")
-            .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
-            .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
-            .env("RAYON_NUM_THREADS", "1")
-            .output()
-            .map_err(|e| format!("mpirun (openmpi-bin, scripts/system-deps.sh): {e}"))?;
+        let out = mpirun_self(ranks, RANK_MARK)?;
         let stdout = String::from_utf8_lossy(&out.stdout);
         if !out.status.success() {
             return Err(format!(

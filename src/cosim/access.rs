@@ -417,11 +417,6 @@ impl Component {
                     if self.mode != Mode::Instantiated && kind != params.backend {
                         return Err(bad("the backend is fixed once initialisation starts".into()));
                     }
-                    if self.ranks.is_some() && kind != BackendKind::Cpu {
-                        return Err(bad(format!(
-                            "{x}: the backend does not run on MPI ranks yet"
-                        )));
-                    }
                     let on = scene.as_ref().unwrap_or(&self.scene);
                     crate::engine::choice::check(kind, &on.world, &on.step_params())
                         .map_err(|e| bad(format!("{x}: {e}")))?;

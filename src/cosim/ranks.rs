@@ -23,7 +23,7 @@ use super::CosimError;
 use super::component::Component;
 use crate::Real;
 use crate::analysis::packing::{BedFigures, bed_figures};
-use crate::engine::choice::BackendKind;
+use crate::engine::choice::{BackendKind, ShareBackend};
 use crate::engine::exchange::{Exchange, Ranks, broadcast_bytes};
 use crate::scene::{Scene, ShareState, SimState, Simulation, StateReader, StateWriter};
 
@@ -154,20 +154,16 @@ pub(super) fn new_simulation(
     exchange: Option<Box<dyn Ranks>>,
     state: Option<&SimState>,
 ) -> Result<Simulation, CosimError> {
-    if exchange.is_some() && backend != BackendKind::Cpu {
-        return Err(CosimError::Ranks(
-            "backend: the cuda backend does not run on MPI ranks yet".into(),
-        ));
-    }
-    let open = || Simulation::on(scene, backend).map_err(CosimError::Backend);
-    match (exchange, state) {
-        (None, None) => open(),
-        (None, Some(state)) => {
-            let mut sim = open()?;
+    let Some(exchange) = exchange else {
+        let mut sim = Simulation::on(scene, backend).map_err(CosimError::Backend)?;
+        if let Some(state) = state {
             sim.restore(state)?;
-            Ok(sim)
         }
-        (Some(exchange), None) => Ok(Simulation::on_ranks(scene, exchange)),
-        (Some(exchange), Some(state)) => Ok(Simulation::on_ranks_from(scene, exchange, state)?),
-    }
+        return Ok(sim);
+    };
+    let share = ShareBackend::open(backend, exchange.rank()).map_err(CosimError::Backend)?;
+    Ok(match state {
+        None => Simulation::on_ranks(scene, share, exchange),
+        Some(state) => Simulation::on_ranks_from(scene, share, exchange, state)?,
+    })
 }

@@ -3,9 +3,14 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::backend::Backend;
+use super::backend::{Backend, ContactHistory};
 use super::cpu::CpuBackend;
+use super::decomposition::Decomposition;
+use super::exchange::Exchange;
 use super::params::StepParams;
+use super::rank::RankStepper;
+use super::stats::StepStats;
+use crate::Real;
 use crate::world::World;
 
 /// What computes the steps of a scene (`[simulation] backend`).
@@ -15,8 +20,9 @@ pub enum BackendKind {
     /// The CPU backend (rayon): every scene.
     #[default]
     Cpu,
-    /// The CUDA backend on GPU 0 (feature `cuda`): scenes of Hertz–Mindlin spheres
-    /// without rolling resistance or a fluid, in one process.
+    /// The CUDA backend (feature `cuda`): scenes of Hertz–Mindlin spheres without
+    /// rolling resistance or a fluid, on GPU 0 in one process, and on MPI ranks
+    /// a GPU each ([`ShareBackend`]).
     Cuda,
 }
 
@@ -44,6 +50,11 @@ impl std::str::FromStr for BackendKind {
     }
 }
 
+/// Why a build without the feature refuses the CUDA backend.
+#[cfg(not(feature = "cuda"))]
+const WITHOUT_CUDA: &str =
+    "this talus was built without the cuda feature (cargo build --features cuda)";
+
 /// Whether `world` can be stepped by `backend` here: `Err` says why not (the
 /// feature not built, a scene the backend does not model, no GPU driver).
 pub fn check(backend: BackendKind, world: &World, params: &StepParams) -> Result<(), String> {
@@ -61,10 +72,7 @@ pub fn check(backend: BackendKind, world: &World, params: &StepParams) -> Result
         #[cfg(not(feature = "cuda"))]
         BackendKind::Cuda => {
             let _ = (world, params);
-            Err(
-                "this talus was built without the cuda feature (cargo build --features cuda)"
-                    .into(),
-            )
+            Err(WITHOUT_CUDA.into())
         }
     }
 }
@@ -88,5 +96,63 @@ pub fn open(
         }
         #[cfg(not(feature = "cuda"))]
         BackendKind::Cuda => unreachable!("refused by check"),
+    }
+}
+
+/// What steps one rank's share of a decomposed run, opened before the share is
+/// cut (the device can fail to open; the share's stepper cannot).
+pub enum ShareBackend {
+    /// The CPU backend.
+    Cpu,
+    /// A GPU (feature `cuda`).
+    #[cfg(feature = "cuda")]
+    Cuda(Box<dyn super::cuda::device::Device>),
+}
+
+impl ShareBackend {
+    /// The backend `kind` for rank `rank`: a GPU opens as GPU `rank mod count` of
+    /// the GPUs this process sees (one GPU a rank, on nodes with as many GPUs as
+    /// ranks). The scene is checked before ([`check`]).
+    pub fn open(kind: BackendKind, rank: usize) -> Result<Self, String> {
+        match kind {
+            BackendKind::Cpu => Ok(ShareBackend::Cpu),
+            #[cfg(feature = "cuda")]
+            BackendKind::Cuda => {
+                let device = super::cuda::driver::CudaDevice::open_for_rank(rank)
+                    .map_err(|e| e.to_string())?;
+                Ok(ShareBackend::Cuda(Box::new(device)))
+            }
+            #[cfg(not(feature = "cuda"))]
+            BackendKind::Cuda => {
+                let _ = rank;
+                Err(WITHOUT_CUDA.into())
+            }
+        }
+    }
+
+    /// This rank's stepper of its share of `world` (see
+    /// [`RankStepper::restored_with`]), bisecting again above `rebalance_above`.
+    pub fn stepper<E: Exchange + Send + std::fmt::Debug + 'static>(
+        self,
+        at: (E, Decomposition, StepParams),
+        world: &mut World,
+        history: &ContactHistory,
+        stats: StepStats,
+        rebalance_above: Real,
+    ) -> Box<dyn Backend> {
+        match self {
+            ShareBackend::Cpu => Box::new(
+                RankStepper::restored_with(at, world, history, stats, CpuBackend::new)
+                    .rebalance_above(rebalance_above),
+            ),
+            #[cfg(feature = "cuda")]
+            ShareBackend::Cuda(device) => {
+                let make = |params| super::cuda::backend::CudaBackend::idle(device, params);
+                Box::new(
+                    RankStepper::restored_with(at, world, history, stats, make)
+                        .rebalance_above(rebalance_above),
+                )
+            }
+        }
     }
 }

@@ -15,9 +15,10 @@ use super::ranks::{REBALANCE_ABOVE, seeds_of, spread_facet_forces, sum_facet_for
 use super::state::SimState;
 use super::state_bytes::StateError;
 use crate::Real;
+use crate::engine::choice::ShareBackend;
 use crate::engine::decomposition::Decomposition;
 use crate::engine::exchange::Exchange;
-use crate::engine::rank::{ParticleRecord, RankStepper, gather_to_first};
+use crate::engine::rank::{ParticleRecord, gather_to_first};
 use crate::engine::{ContactHistory, CpuBackend};
 use crate::world::Particles;
 
@@ -118,9 +119,11 @@ impl Simulation {
     /// A run of `scene` on the ranks of `exchange` that continues from `state` (the
     /// whole run's, as [`Simulation::whole_snapshot`] or one process saved it;
     /// every rank passes the same): each rank keeps its share, the particles with
-    /// the saved forces, and the next step continues the saved run to the bit.
+    /// the saved forces, and the next step continues the saved run to the bit
+    /// (on `backend`, opened for this rank).
     pub fn on_ranks_from<E: Exchange + Send + fmt::Debug + 'static>(
         scene: &Scene,
+        backend: ShareBackend,
         exchange: E,
         state: &SimState,
     ) -> Result<Self, StateError> {
@@ -134,22 +137,20 @@ impl Simulation {
         let mut world = sim.world.clone();
         let seeds = seeds_of(&world);
         let layout = Decomposition::bisect(&seeds, &vec![1.0; seeds.len()], exchange.size());
-        let stepper = RankStepper::restored(
-            exchange,
-            layout,
-            params,
+        let rank = exchange.rank();
+        let stepper = backend.stepper(
+            (exchange, layout, params),
             &mut world,
             &state.history,
             Default::default(),
-        )
-        .rebalance_above(REBALANCE_ABOVE);
+            REBALANCE_ABOVE,
+        );
         if let Some(fluid) = &state.fluid {
-            let rank = stepper.exchange().rank();
             keep_fluid_share(&mut world, fluid, &state.particles.id, rank);
         }
         sim.world = world;
         sim.particles_behind = false;
-        sim.backend = Box::new(stepper);
+        sim.backend = stepper;
         sim.reduce_over_ranks(HeldEnergy::default(), 0.0);
         // The walls and figures of the step that ended, as saved (the ranks' own
         // start from nothing).

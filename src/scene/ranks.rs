@@ -25,9 +25,10 @@ use super::energy_ledger::{EnergyLedger, HeldEnergy};
 use super::fluid_ranks::whole_fluid;
 use crate::Real;
 use crate::analysis::packing::{Bed, bed_height_of, measured_from};
+use crate::engine::choice::ShareBackend;
 use crate::engine::decomposition::Decomposition;
 use crate::engine::exchange::Exchange;
-use crate::engine::rank::{ParticleRecord, RankStepper, Share, all_gather, gather_to_first};
+use crate::engine::rank::{ParticleRecord, Share, all_gather, gather_to_first};
 use crate::engine::{ContactHistory, StepStats};
 use crate::world::{MassMoments, Particles, World};
 
@@ -105,8 +106,12 @@ impl Simulation {
     /// world, as one process does, bisects the space at the particles (at the
     /// walls when there are none yet) and keeps its share; then, as one process,
     /// splits the particles among a coupled fluid's cells and evaluates the first
-    /// forces.
-    pub fn on_ranks<E: Exchange + Send + fmt::Debug + 'static>(scene: &Scene, exchange: E) -> Self {
+    /// forces. The ranks step their shares on `backend` (opened for this rank).
+    pub fn on_ranks<E: Exchange + Send + fmt::Debug + 'static>(
+        scene: &Scene,
+        backend: ShareBackend,
+        exchange: E,
+    ) -> Self {
         let mut world = scene.world.clone();
         let mut inlets = scene.inlets.clone();
         let mut next_id = scene.next_id;
@@ -115,16 +120,14 @@ impl Simulation {
         }
         let seeds = seeds_of(&world);
         let layout = Decomposition::bisect(&seeds, &vec![1.0; seeds.len()], exchange.size());
-        let stepper = RankStepper::restored(
-            exchange,
-            layout,
-            scene.step_params(),
+        let stepper = backend.stepper(
+            (exchange, layout, scene.step_params()),
             &mut world,
             &ContactHistory::default(),
             StepStats::default(),
-        )
-        .rebalance_above(REBALANCE_ABOVE);
-        let mut sim = Simulation::assemble(scene, world, Box::new(stepper));
+            REBALANCE_ABOVE,
+        );
+        let mut sim = Simulation::assemble(scene, world, stepper);
         sim.inlets = inlets;
         sim.next_id = next_id;
         sim.update_fluid();

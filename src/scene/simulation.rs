@@ -382,9 +382,12 @@ impl Simulation {
 
     /// Whether the host's work after the step that began at `before` reads or changes
     /// the particles: inlets still inserting, the bed measured, the settling test, a
-    /// fluid. (Ranks step the host world itself: nothing to copy there.)
+    /// fluid, and on ranks the whole run's figures, reduced every step from each
+    /// rank's particles (`ranks.rs`; the CPU backend steps the host world itself,
+    /// so nothing is copied there).
     fn reads_particles_between_steps(&self, before: Real) -> bool {
-        !self.inlets_done()
+        self.backend.share().is_some()
+            || !self.inlets_done()
             || self.bed_measured_after(before)
             || self.settle.is_some()
             || self.world.fluid.is_some()
@@ -406,6 +409,9 @@ impl Simulation {
             let first = self.world.particles.owned();
             share.insert(&mut self.world, &mut self.inlets, &mut self.next_id);
             let added = first..self.world.particles.owned();
+            if !added.is_empty() {
+                self.backend.particles_added(&self.world, added.clone());
+            }
             return HeldEnergy::of_particles(&self.world, added);
         }
         let first = self.world.particles.len();

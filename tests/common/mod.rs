@@ -211,6 +211,51 @@ pub fn fluid_swirl(cells: usize, phase: f64) -> Vec<f64> {
         .collect()
 }
 
+/// This test program run under `mpirun --oversubscribe -np ranks` (more ranks than
+/// cores; as root too, with OpenMPI's consent variables; a thread a rank), with
+/// `mark` set in the environment of the copies it starts.
+pub fn mpirun_self(ranks: usize, mark: &str) -> Result<std::process::Output, String> {
+    let program = std::env::current_exe().map_err(|e| e.to_string())?;
+    std::process::Command::new("mpirun")
+        .args(["--oversubscribe", "-np", &ranks.to_string()])
+        .arg(&program)
+        .env(mark, "1")
+        .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
+        .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
+        .env("RAYON_NUM_THREADS", "1")
+        .output()
+        .map_err(|e| format!("mpirun (openmpi-bin, scripts/system-deps.sh): {e}"))
+}
+
+/// The head of a scene of Hertz–Mindlin spheres: a step of 20 µs, gravity, glass
+/// and steel, big (5 mm) and small (4 mm) spheres; the particles and walls follow.
+pub const GLASS_AND_STEEL_SPHERES: &str = r#"
+[simulation]
+dt = 2e-5
+end_time = 1.0
+gravity = [0.0, 0.0, -9.81]
+[contact]
+law = "hertz_mindlin"
+[materials.glass]
+density = 2500.0
+young = 1e7
+poisson = 0.3
+restitution = 0.5
+friction = 0.5
+[materials.steel]
+density = 7800.0
+young = 2e7
+poisson = 0.25
+restitution = 0.7
+friction = 0.3
+[shapes.big]
+kind = "sphere"
+radius = 0.005
+[shapes.small]
+kind = "sphere"
+radius = 0.004
+"#;
+
 /// Equal to 1e-12 of the larger: two sums of the same terms in other orders (the
 /// CUDA backend's tree of sums, the CPU backend's serial sum; some thousand terms,
 /// each sum's round-off within a few ulps of its terms').

@@ -153,16 +153,15 @@ impl Launch {
             }
             #[cfg(feature = "mpi")]
             Launch::Rank { exchange, .. } => {
-                anyhow::ensure!(
-                    scene.backend() == talus::engine::choice::BackendKind::Cpu,
-                    "simulation.backend: the cuda backend does not run on MPI ranks yet"
-                );
                 let exchange = exchange
                     .take()
                     .ok_or_else(|| anyhow::anyhow!("one simulation per rank"))?;
+                let rank = talus::engine::exchange::Exchange::rank(&exchange);
+                let share = talus::engine::choice::ShareBackend::open(scene.backend(), rank)
+                    .map_err(|e| anyhow::anyhow!("simulation.backend: {e}"))?;
                 Ok(match state {
-                    Some(state) => Simulation::on_ranks_from(scene, exchange, state)?,
-                    None => Simulation::on_ranks(scene, exchange),
+                    Some(state) => Simulation::on_ranks_from(scene, share, exchange, state)?,
+                    None => Simulation::on_ranks(scene, share, exchange),
                 })
             }
         }

@@ -10,6 +10,11 @@
 //! removed or anything else rebuild the stepper from the host world at the next
 //! evaluation, the contact history carried over.
 //!
+//! On an MPI rank it steps the rank's share ([`ShareStepper`]): in a step without a
+//! renewal only the halo crosses (the states of the particles sent as ghosts down,
+//! the ghosts' states up); a renewal copies the owned particles down, and the
+//! stepper is made again from the rank's new share.
+//!
 //! A device call that fails (a lost GPU, a sphere at more than four walls) panics:
 //! the seam's calls are infallible, and a backend that lost its state cannot go on.
 
@@ -20,6 +25,7 @@ use super::spheres::{DeviceSpheres, SpheresError};
 use crate::Real;
 use crate::engine::backend::{Backend, ContactHistory};
 use crate::engine::params::StepParams;
+use crate::engine::rank::ShareStepper;
 use crate::engine::stats::{StageTimes, StepStats};
 use crate::world::World;
 
@@ -37,8 +43,8 @@ pub struct CudaBackend {
     touching: Vec<bool>,
     /// Particles integrated (not frozen) by the stepper.
     integrated: usize,
-    /// Steppers made again from the whole host world since the first.
-    rebuilds: u64,
+    /// Steppers made from the whole host world.
+    made: u64,
 }
 
 impl fmt::Debug for CudaBackend {
@@ -68,23 +74,43 @@ impl CudaBackend {
     ) -> Result<Self, SpheresError> {
         let spheres = DeviceSpheres::new(device, world, &params)?;
         Ok(CudaBackend {
+            spheres: Some(spheres),
+            integrated: integrated(world),
+            made: 1,
+            ..Self::without_device(params)
+        })
+    }
+
+    /// A backend on `device` that makes its stepper from the host world at the
+    /// first evaluation (a rank's, once it has cut its share; the world checked
+    /// by [`DeviceSpheres::check`] before).
+    pub fn idle(device: Box<dyn Device>, params: StepParams) -> Self {
+        CudaBackend {
+            idle: Some(device),
+            ..Self::without_device(params)
+        }
+    }
+
+    /// The fields of a backend before it holds a device.
+    fn without_device(params: StepParams) -> Self {
+        CudaBackend {
             params,
             idle: None,
-            spheres: Some(spheres),
+            spheres: None,
             history: None,
             stats: StepStats::default(),
             times: StageTimes::default(),
             touching: Vec::new(),
-            integrated: integrated(world),
-            rebuilds: 0,
-        })
+            integrated: 0,
+            made: 0,
+        }
     }
 
     /// How many times the stepper was made again from the whole host world (a change
     /// the backend does not upload alone: particles removed, parameters or the
-    /// world changed, a state restored).
+    /// world changed, a state restored, a rank's renewal).
     pub fn rebuilds(&self) -> u64 {
-        self.rebuilds
+        self.made.saturating_sub(1)
     }
 
     /// The stepper, rebuilt from `world` if the host changed it.
@@ -98,7 +124,7 @@ impl CudaBackend {
             }
             self.spheres = Some(spheres);
             self.integrated = integrated(world);
-            self.rebuilds += 1;
+            self.made += 1;
         }
         self.spheres.as_mut().expect("a stepper")
     }
@@ -239,5 +265,57 @@ impl Backend for CudaBackend {
 
     fn particles_on_host(&self) -> bool {
         false
+    }
+}
+
+/// A rank's share on the device (see the module): the halo alone crosses in a step
+/// without a renewal.
+impl ShareStepper for CudaBackend {
+    /// The opening kick and drift on the device; the walls' poses and the clock
+    /// of the step's end into the host world (a renewal makes the stepper again
+    /// from it).
+    fn drift(&mut self, world: &mut World, dt: Real) {
+        let spheres = self.stepper(world);
+        spheres.drift(dt).unwrap_or_else(|e| fail(e));
+        spheres.walls_to_host(world);
+    }
+
+    /// The sent particles' states, each once, from the device.
+    fn owned_to_host(&mut self, world: &mut World, sends: &[Vec<usize>]) {
+        let mut entries = sends.concat();
+        entries.sort_unstable();
+        entries.dedup();
+        let spheres = self.stepper(world);
+        spheres
+            .states_to_host(world, &entries)
+            .unwrap_or_else(|e| fail(e));
+    }
+
+    fn ghosts_from_host(&mut self, world: &World) {
+        let spheres = self.stepper(world);
+        spheres.ghosts_from_host(world).unwrap_or_else(|e| fail(e));
+    }
+
+    /// Stale when the device's list is, or when the stepper is to be made again.
+    fn is_stale(&mut self, _world: &World) -> bool {
+        match self.spheres.as_mut() {
+            Some(spheres) => spheres.is_stale().unwrap_or_else(|e| fail(e)),
+            None => true,
+        }
+    }
+
+    fn forces(&mut self, world: &mut World, dt: Real) {
+        self.stepper(world).forces(dt).unwrap_or_else(|e| fail(e));
+        self.report_to_host(world);
+    }
+
+    fn close(&mut self, world: &mut World, dt: Real) {
+        self.stepper(world).close(dt).unwrap_or_else(|e| fail(e));
+    }
+
+    /// One a particle: the device's step costs the ranks by their particles (its
+    /// lists are not read back).
+    fn costs(&self, world: &World) -> Vec<Real> {
+        vec![1.0; world.particles.owned()]
     }
 }

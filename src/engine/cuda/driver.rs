@@ -45,6 +45,19 @@ impl CudaDevice {
         unsafe { cudarc::driver::sys::is_culib_present() }
     }
 
+    /// Opens the GPU of MPI rank `rank`: GPU `rank mod count` of the `count` GPUs
+    /// this process sees.
+    pub fn open_for_rank(rank: usize) -> Result<Self, DeviceError> {
+        if !Self::is_present() {
+            return Err(DeviceError::NoDriver);
+        }
+        let count = CudaContext::device_count().map_err(driver)?;
+        if count <= 0 {
+            return Err(DeviceError::Driver("the CUDA driver sees no GPU".into()));
+        }
+        Self::open(rank % count as usize)
+    }
+
     /// Opens GPU `ordinal` and compiles every kernel for it.
     pub fn open(ordinal: usize) -> Result<Self, DeviceError> {
         if !Self::is_present() {

@@ -51,7 +51,7 @@ pub static CONTACT: KernelFile = KernelFile {
 };
 
 /// The kernel files, each compiled to one module.
-pub static FILES: [KernelFile; 6] = [
+pub static FILES: [KernelFile; 7] = [
     KernelFile {
         name: "integrate.cu",
         source: include_str!("../../../kernels/integrate.cu"),
@@ -80,6 +80,11 @@ pub static FILES: [KernelFile; 6] = [
     KernelFile {
         name: "sums.cu",
         source: include_str!("../../../kernels/sums.cu"),
+        headers: &[&VEC, &CONTACT],
+    },
+    KernelFile {
+        name: "halo.cu",
+        source: include_str!("../../../kernels/halo.cu"),
         headers: &[&VEC, &CONTACT],
     },
 ];
@@ -137,11 +142,15 @@ pub enum Kernel {
     PairEnergyPartials,
     /// A pass of the deterministic sums (`sums.cu`).
     SumRecords,
+    /// The states of the particles sent as ghosts, packed (`halo.cu`).
+    PackStates,
+    /// The ghosts' states received, unpacked into their slots (`halo.cu`).
+    UnpackGhostStates,
 }
 
 impl Kernel {
     /// Every kernel.
-    pub const ALL: [Kernel; 25] = [
+    pub const ALL: [Kernel; 27] = [
         Kernel::KickDrift,
         Kernel::ClosingKick,
         Kernel::BinParticles,
@@ -167,6 +176,8 @@ impl Kernel {
         Kernel::WallEnergyTerms,
         Kernel::PairEnergyPartials,
         Kernel::SumRecords,
+        Kernel::PackStates,
+        Kernel::UnpackGhostStates,
     ];
 
     /// Its name in the source (`extern "C"`, so the PTX entry has it too).
@@ -197,6 +208,8 @@ impl Kernel {
             Kernel::WallEnergyTerms => "wall_energy_terms",
             Kernel::PairEnergyPartials => "pair_energy_partials",
             Kernel::SumRecords => "sum_records",
+            Kernel::PackStates => "pack_states",
+            Kernel::UnpackGhostStates => "unpack_ghost_states",
         }
     }
 
@@ -213,6 +226,7 @@ impl Kernel {
             SphereContacts | GatherForces => 3,
             SphereWalls | WallSumRows | WallEnergyTerms => 4,
             PairEnergyPartials | SumRecords => 5,
+            PackStates | UnpackGhostStates => 6,
         };
         &FILES[index]
     }

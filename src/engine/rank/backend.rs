@@ -12,6 +12,7 @@ use std::ops::Range;
 
 use super::RankStepper;
 use super::share::Share;
+use super::stepper::ShareStepper;
 use crate::Real;
 use crate::engine::backend::{Backend, ContactHistory};
 use crate::engine::exchange::Exchange;
@@ -19,9 +20,9 @@ use crate::engine::params::StepParams;
 use crate::engine::stats::{StageTimes, StepStats};
 use crate::world::World;
 
-impl<E: Exchange + Send + fmt::Debug> Backend for RankStepper<E> {
+impl<E: Exchange + Send + fmt::Debug, B: ShareStepper> Backend for RankStepper<E, B> {
     fn name(&self) -> &'static str {
-        "cpu"
+        self.backend.name()
     }
 
     fn params(&self) -> &StepParams {

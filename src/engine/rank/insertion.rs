@@ -12,11 +12,12 @@
 use nalgebra::Point3;
 
 use super::RankStepper;
+use super::stepper::ShareStepper;
 use crate::Real;
 use crate::engine::exchange::Exchange;
 use crate::world::{Inlet, Obstacle, World};
 
-impl<E: Exchange> RankStepper<E> {
+impl<E: Exchange, B: ShareStepper> RankStepper<E, B> {
     /// Lets the `inlets` insert what is due at the world's time. Every rank calls
     /// it after the same step with the same inlets and `next_id`, which advance
     /// alike on all. A new particle owned here gets its weight as the force of its

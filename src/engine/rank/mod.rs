@@ -1,7 +1,8 @@
 //! One rank of a decomposed run: it owns the particles whose centroids lie in its
 //! box of a [`Decomposition`], holds ghost copies of the others' particles within
-//! reach, and steps its share with a [`CpuBackend`] so that every particle moves
-//! to the same bits as in one process.
+//! reach, and steps its share with a [`ShareStepper`] (the [`CpuBackend`], or a
+//! device backend) so that every particle moves to the same bits as in one
+//! process.
 //!
 //! **A step.** The opening kick and drift of the owned particles; the ghosts'
 //! states refreshed from their owners; if any rank's lists are stale (one answer
@@ -25,7 +26,7 @@ use std::ops::Range;
 
 use nalgebra::Point3;
 
-use super::backend::{Backend, ContactHistory};
+use super::backend::ContactHistory;
 use super::cpu::CpuBackend;
 use super::decomposition::Decomposition;
 use super::exchange::Exchange;
@@ -40,11 +41,13 @@ mod cost;
 mod insertion;
 mod records;
 mod share;
+mod stepper;
 
 pub use cost::{PARTICLE_COST, POLYHEDRON_PAIR_COST, particle_costs};
 pub use records::ParticleRecord;
 use records::{Migrant, history_of};
 pub use share::{Share, all_gather, all_to_all, gather_to_first};
+pub use stepper::ShareStepper;
 
 /// Steps one rank's share of a decomposed world.
 ///
@@ -52,11 +55,11 @@ pub use share::{Share, all_gather, all_to_all, gather_to_first};
 /// the last renewal) first, then the ghosts in the order of `sends` of the ranks
 /// before and after this one (rank order, then the sender's order).
 #[derive(Debug)]
-pub struct RankStepper<E: Exchange> {
+pub struct RankStepper<E: Exchange, B: ShareStepper = CpuBackend> {
     exchange: E,
     decomposition: Decomposition,
     reach: Real,
-    backend: CpuBackend,
+    backend: B,
     /// For each rank, the owned particles copied there as ghosts.
     sends: Vec<Vec<usize>>,
     /// No skin was set: it follows the smallest particle of the whole run at each
@@ -74,11 +77,11 @@ impl<E: Exchange> RankStepper<E> {
     /// Takes this rank's share of `world` (every rank passes the same world and
     /// decomposition): keeps the particles it owns, adds the ghosts within reach
     /// (twice the largest bounding radius of a body type plus the skin), and
-    /// evaluates the forces for a first step of `dt`. `history` is the whole run's
-    /// tangential history (of a restored state; empty for a fresh start): the rank
-    /// keeps what concerns its own particles. Without a skin in `params` the ranks
-    /// choose it from the whole run's particles at every renewal, as one process
-    /// chooses it at every list build.
+    /// evaluates the forces for a first step of `dt` on the CPU backend. `history`
+    /// is the whole run's tangential history (of a restored state; empty for a
+    /// fresh start): the rank keeps what concerns its own particles. Without a
+    /// skin in `params` the ranks choose it from the whole run's particles at
+    /// every renewal, as one process chooses it at every list build.
     pub fn new(
         exchange: E,
         decomposition: Decomposition,
@@ -87,16 +90,8 @@ impl<E: Exchange> RankStepper<E> {
         history: &ContactHistory,
         dt: Real,
     ) -> Self {
-        let mut rank = Self::restored(
-            exchange,
-            decomposition,
-            params,
-            world,
-            history,
-            StepStats::default(),
-        );
-        rank.backend.initialise(world, dt);
-        rank
+        let at = (exchange, decomposition, params);
+        Self::new_with(at, world, history, dt, CpuBackend::new)
     }
 
     /// Takes this rank's share of a restored `world` as [`RankStepper::new`] does,
@@ -106,10 +101,39 @@ impl<E: Exchange> RankStepper<E> {
     pub fn restored(
         exchange: E,
         decomposition: Decomposition,
-        mut params: StepParams,
+        params: StepParams,
         world: &mut World,
         history: &ContactHistory,
         stats: StepStats,
+    ) -> Self {
+        let at = (exchange, decomposition, params);
+        Self::restored_with(at, world, history, stats, CpuBackend::new)
+    }
+}
+
+impl<E: Exchange, B: ShareStepper> RankStepper<E, B> {
+    /// [`RankStepper::new`] on the backend `make` gives for the step parameters
+    /// (their skin set).
+    pub fn new_with(
+        at: (E, Decomposition, StepParams),
+        world: &mut World,
+        history: &ContactHistory,
+        dt: Real,
+        make: impl FnOnce(StepParams) -> B,
+    ) -> Self {
+        let mut rank = Self::restored_with(at, world, history, StepStats::default(), make);
+        rank.backend.initialise(world, dt);
+        rank
+    }
+
+    /// [`RankStepper::restored`] on the backend `make` gives for the step
+    /// parameters (their skin set).
+    pub fn restored_with(
+        (exchange, decomposition, mut params): (E, Decomposition, StepParams),
+        world: &mut World,
+        history: &ContactHistory,
+        stats: StepStats,
+        make: impl FnOnce(StepParams) -> B,
     ) -> Self {
         assert_eq!(exchange.size(), decomposition.ranks(), "one box per rank");
         // Every rank holds the whole world here: its own radii are everyone's.
@@ -130,7 +154,7 @@ impl<E: Exchange> RankStepper<E> {
             exchange,
             decomposition,
             reach,
-            backend: CpuBackend::new(params),
+            backend: make(params),
             rebalance_above: None,
             imbalance: 1.0,
             rebalances: 0,
@@ -186,7 +210,7 @@ impl<E: Exchange> RankStepper<E> {
     }
 
     /// The backend (figures and lists of this rank's share).
-    pub fn backend(&self) -> &CpuBackend {
+    pub fn backend(&self) -> &B {
         &self.backend
     }
 
@@ -209,8 +233,9 @@ impl<E: Exchange> RankStepper<E> {
     pub fn step(&mut self, world: &mut World, dt: Real) {
         self.backend.drift(world, dt);
         self.refresh_ghosts(world);
-        let stale = self.exchange.any(self.backend.neighbours().is_stale(world));
+        let stale = self.exchange.any(self.backend.is_stale(world));
         if stale {
+            self.backend.sync_to_host(world);
             self.renew(world);
         }
         self.backend.forces(world, dt);
@@ -219,11 +244,13 @@ impl<E: Exchange> RankStepper<E> {
 
     /// Copies the owned particles' states to the ranks where they are ghosts.
     fn refresh_ghosts(&mut self, world: &mut World) {
+        self.backend.owned_to_host(world, &self.sends);
         let received = self.send_ghost_states(world);
         let p = &mut world.particles;
         for (k, record) in received.iter().flatten().enumerate() {
             record.set_state(p, p.owned() + k);
         }
+        self.backend.ghosts_from_host(world);
     }
 
     /// Sends the states of the owned particles in `sends` to their ranks; returns
@@ -324,7 +351,7 @@ impl<E: Exchange> RankStepper<E> {
     /// all of them and computes the same boxes, whatever order they came in.
     fn rebalance(&mut self, world: &World, threshold: Real) {
         let size = self.exchange.size();
-        let cost = particle_costs(world, self.backend.neighbours());
+        let cost = self.backend.costs(world);
         let total: Real = cost.iter().sum();
         let totals = self.exchange.all_to_all(vec![vec![total]; size]).concat();
         let mean = totals.iter().sum::<Real>() / size as Real;

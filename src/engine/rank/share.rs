@@ -4,6 +4,7 @@
 //! process would insert.
 
 use super::RankStepper;
+use super::stepper::ShareStepper;
 use crate::engine::exchange::Exchange;
 use crate::engine::wire::{Message, decode_list, encode_list};
 use crate::world::{Inlet, World};
@@ -60,7 +61,7 @@ pub fn gather_to_first<T: Message>(share: &dyn Share, mine: &[T]) -> Vec<Vec<T>>
     }
 }
 
-impl<E: Exchange> Share for RankStepper<E> {
+impl<E: Exchange, B: ShareStepper> Share for RankStepper<E, B> {
     fn rank(&self) -> usize {
         self.exchange.rank()
     }

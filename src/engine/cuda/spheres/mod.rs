@@ -25,6 +25,7 @@
 
 use nalgebra::{Point3, UnitQuaternion, Vector3};
 
+mod halo;
 mod transfer;
 
 use super::Kernel;
@@ -111,6 +112,14 @@ pub struct DeviceSpheres {
     n: usize,
     /// The host world's entry of each device slot: the entries in id order.
     order: Vec<usize>,
+    /// The device slot of each host entry (the inverse of `order`).
+    slot_of: Vec<u32>,
+    /// Owned entries of the host world (the ghosts follow them).
+    owned: usize,
+    /// Whether the list is stale, when asked since the particles last moved.
+    stale: Option<bool>,
+    /// The halo's slots and state records (`halo.rs`).
+    halo: halo::HaloArrays,
     gravity: Vector3<Real>,
     time: Real,
     types: TypeArrays,
@@ -153,6 +162,15 @@ fn id_order(p: &Particles) -> Vec<usize> {
 /// `values` of the host entries `order`.
 fn in_order<T: Copy>(values: &[T], order: &[usize]) -> Vec<T> {
     order.iter().map(|&i| values[i]).collect()
+}
+
+/// The device slot of each host entry, for the entries in device order `order`.
+fn slots_of(order: &[usize]) -> Vec<u32> {
+    let mut slot_of = vec![0; order.len()];
+    for (k, &i) in order.iter().enumerate() {
+        slot_of[i] = k as u32;
+    }
+    slot_of
 }
 
 /// The role bytes of the host entries `order`.
@@ -226,10 +244,15 @@ impl DeviceSpheres {
         let list = DeviceList::new(skin, 2.0 * largest + skin);
         let walls = DeviceWalls::new(d, world, p.len())?;
         let readback = Readback::new(d, walls.sums_width())?;
+        let order = id_order(p);
         let mut spheres = DeviceSpheres {
             device,
             n: p.len(),
-            order: id_order(p),
+            slot_of: slots_of(&order),
+            order,
+            owned: p.owned(),
+            stale: None,
+            halo: Default::default(),
             gravity: world.gravity,
             time: world.time,
             types,
@@ -287,6 +310,7 @@ impl DeviceSpheres {
         a.id.write(d, &in_order(&p.id, order))?;
         a.touching.resize(d, p.len())?;
         self.list.invalidate();
+        self.stale = None;
         Ok(())
     }
 
@@ -322,6 +346,16 @@ impl DeviceSpheres {
 
     /// One velocity-Verlet step of length `dt`: the stages in order.
     pub fn step(&mut self, dt: Real) -> Result<(), DeviceError> {
+        self.drift(dt)?;
+        self.forces(dt)?;
+        self.close(dt)
+    }
+
+    /// The first part of a step: the opening half kick and the drift of the
+    /// particles that move here, and the walls moved to the step's end. A rank
+    /// refreshes its ghosts after it (`halo.rs`), before [`Self::forces`].
+    pub fn drift(&mut self, dt: Real) -> Result<(), DeviceError> {
+        self.stale = None;
         let (d, p, t) = (self.device.as_mut(), &self.particles, &self.types);
         let n = Arg::U32(self.n as u32);
         // SAFETY: the parameters of kick_drift, each array sized for n particles or
@@ -349,9 +383,15 @@ impl DeviceSpheres {
         }
         self.walls.advance(self.device.as_mut(), dt)?;
         self.time = self.walls.time();
-        self.forces(dt)?;
+        Ok(())
+    }
+
+    /// The closing half kick of the particles that move here.
+    pub fn close(&mut self, dt: Real) -> Result<(), DeviceError> {
+        let n = Arg::U32(self.n as u32);
         let (d, p, t) = (self.device.as_mut(), &self.particles, &self.types);
-        // SAFETY: as above, closing_kick's parameters.
+        // SAFETY: closing_kick's parameters (integrate.cu), each array sized for n
+        // particles or the body types.
         unsafe {
             run(
                 d,
@@ -372,9 +412,23 @@ impl DeviceSpheres {
         }
     }
 
+    /// Whether the list must be built again before the next force evaluation
+    /// (a particle moved half a skin since the build, or the list was invalidated).
+    pub fn is_stale(&mut self) -> Result<bool, DeviceError> {
+        if let Some(stale) = self.stale {
+            return Ok(stale);
+        }
+        let d = self.device.as_mut();
+        let stale = self.list.is_stale(d, self.n, &self.particles.position)?;
+        self.stale = Some(stale);
+        Ok(stale)
+    }
+
     /// The force evaluation: the list brought up to date, the pair contacts, the
-    /// gather.
-    fn forces(&mut self, dt: Real) -> Result<(), DeviceError> {
+    /// gather, the walls, the sums.
+    pub fn forces(&mut self, dt: Real) -> Result<(), DeviceError> {
+        let stale = self.is_stale()?;
+        self.stale = None;
         let d = self.device.as_mut();
         let (p, t, pairs, list) = (
             &self.particles,
@@ -382,7 +436,7 @@ impl DeviceSpheres {
             &mut self.pairs,
             &mut self.list,
         );
-        if list.is_stale(d, self.n, &p.position)? {
+        if stale {
             let inputs = ListInputs {
                 n: self.n,
                 position: &p.position,

@@ -99,6 +99,7 @@ impl DeviceSpheres {
         self.list.old_pair_count = history.pairs.len();
         self.list.pending = true;
         self.list.invalidate();
+        self.stale = None;
         self.pairs.old_history.write(d, &springs)?;
         let ids = self.particles.id.read(d)?;
         self.walls.set_history(d, &ids, &history.walls)
@@ -114,6 +115,8 @@ impl DeviceSpheres {
         let p = &world.particles;
         let (from, n) = (self.n, p.len());
         self.order.extend(from..n);
+        self.slot_of.extend((from..n).map(|k| k as u32));
+        self.owned = p.owned();
         let (d, a) = (self.device.as_mut(), &mut self.particles);
         grow(d, &mut a.position, from, n, |r| points(&p.position[r]))?;
         grow(d, &mut a.velocity, from, n, |r| vectors(&p.velocity[r]))?;
@@ -134,6 +137,7 @@ impl DeviceSpheres {
         self.walls.grow(d, n)?;
         self.n = n;
         self.list.invalidate();
+        self.stale = None;
         Ok(())
     }
 
@@ -217,11 +221,17 @@ impl DeviceSpheres {
 
     /// The pairs' tangential history, sorted by the particles' ids (pairs apart,
     /// whose history is empty, left out): the CPU backend's
-    /// [`crate::engine::Backend::contact_history`].
+    /// [`crate::engine::Backend::contact_history`]. A history set since the last
+    /// build ([`Self::set_history`]) is the history until the next build carries
+    /// it into the list.
     pub fn contact_history(&self) -> Result<ContactHistory, DeviceError> {
         let d = self.device.as_ref();
-        let keys = self.list.keys.read(d)?;
-        let history = self.pairs.history.read(d)?;
+        let (keys, history) = if self.list.pending {
+            (&self.list.old_keys, &self.pairs.old_history)
+        } else {
+            (&self.list.keys, &self.pairs.history)
+        };
+        let (keys, history) = (keys.read(d)?, history.read(d)?);
         let pairs = keys
             .chunks_exact(2)
             .zip(history.chunks_exact(HISTORY))
