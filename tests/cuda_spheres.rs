@@ -253,16 +253,22 @@ fn a_converging_cloud_steps_as_the_cpu_backend_to_the_bit() {
 type Run = fn(Box<dyn Device>);
 
 /// The same runs on a GPU, where there is one (`scripts/gpu-check.sh`): the
-/// converging cloud, the cloud thrown into a box and the turning drum. The kernels
+/// converging cloud, the cloud thrown into a box, the turning drum, and both
+/// clouds as a rank's share with ghosts. The kernels
 /// are compiled without fused multiply–adds and with IEEE division and square
 /// roots, and the only atomics are on integers, so the GPU gives the same bits.
 /// Without a driver the test says so and passes, unless `TALUS_REQUIRE_GPU` is set.
 #[test]
 fn on_a_gpu_the_cloud_the_box_and_the_drum_step_as_the_cpu_backend_to_the_bit() {
-    let runs: [(&str, Run); 3] = [
+    let runs: [(&str, Run); 5] = [
         ("the converging cloud", steps_as_the_cpu_backend),
         ("the cloud thrown into a box", thrown_into_a_box),
         ("the turning drum", beads_in_a_turning_drum),
+        ("a rank's share of the converging cloud", converging_share),
+        (
+            "a rank's share of the cloud thrown into a box",
+            thrown_share,
+        ),
     ];
     for (name, run) in runs {
         match CudaDevice::open(0) {
@@ -439,22 +445,38 @@ fn as_a_share(world: &World, ghost: impl Fn(&Point3<f64>) -> bool) -> World {
 /// energies to round-off).
 #[test]
 fn a_ranks_share_with_ghosts_steps_as_the_cpu_backend_to_the_bit() {
-    let runs = [-35.0, 30.0].map(|spread| {
-        let (whole, params) = cloud_in(OPEN_BOX, spread);
-        let start = as_a_share(&whole, |x| x.x > 0.015);
-        let p = &start.particles;
-        assert!(
-            p.ghosts() >= 300 && p.owned() >= 500,
-            "{} ghosts",
-            p.ghosts()
-        );
-        assert!(!p.id.is_sorted());
-        assert!((p.owned()..p.len()).any(|i| p.frozen[i]));
-        parity(host(64), &start, &params, 1000, false)
-    });
-    let (converging, thrown) = (runs[0].most_contacts, runs[1].most_wall_contacts);
-    assert!(converging > 500, "{converging} contacts");
-    assert!(thrown > 50, "{thrown} wall contacts");
+    converging_share(host(64));
+    thrown_share(host(64));
+}
+
+/// The converging cloud as a rank's share: many pairs with ghosts.
+fn converging_share(device: Box<dyn Device>) {
+    let run = share_with_ghosts(device, -35.0);
+    assert!(run.most_contacts > 500, "{} contacts", run.most_contacts);
+}
+
+/// The cloud thrown into the box as a rank's share: many wall contacts.
+fn thrown_share(device: Box<dyn Device>) {
+    let run = share_with_ghosts(device, 30.0);
+    let walls = run.most_wall_contacts;
+    assert!(walls > 50, "{walls} wall contacts");
+}
+
+/// The cloud in the box, its spheres moving at `spread` times their position, as
+/// a rank holds its share (see [`as_a_share`]), stepped on `device` against the
+/// CPU backend.
+fn share_with_ghosts(device: Box<dyn Device>, spread: f64) -> Parity {
+    let (whole, params) = cloud_in(OPEN_BOX, spread);
+    let start = as_a_share(&whole, |x| x.x > 0.015);
+    let p = &start.particles;
+    assert!(
+        p.ghosts() >= 300 && p.owned() >= 500,
+        "{} ghosts",
+        p.ghosts()
+    );
+    assert!(!p.id.is_sorted());
+    assert!((p.owned()..p.len()).any(|i| p.frozen[i]));
+    parity(device, &start, &params, 1000, false)
 }
 
 /// What the device stepper does not model yet is refused with what it is.
