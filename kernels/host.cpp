@@ -20,6 +20,7 @@ thread_local dim3 threadIdx, blockIdx, blockDim, gridDim;
 #include "walls.cu"
 #include "sums.cu"
 #include "halo.cu"
+#include "figures.cu"
 
 // Sets the built-ins of the calling thread before it runs one kernel thread.
 extern "C" void talus_host_at(unsigned block, unsigned thread, unsigned block_dim,
@@ -63,7 +64,8 @@ static const Entry kernels[] = {
     KERNEL(sphere_contacts),   KERNEL(gather_forces),
     KERNEL(sphere_walls),      KERNEL(wall_sum_rows),    KERNEL(wall_energy_terms),
     KERNEL(pair_energy_partials), KERNEL(sum_records),
-    KERNEL(pack_states),       KERNEL(unpack_ghost_states),
+    KERNEL(pack_states),       KERNEL(unpack_ghost_states), KERNEL(max_records),
+    KERNEL(particle_figures),
 };
 
 // The trampoline of the kernel named `name`, or null.

@@ -39,6 +39,32 @@ extern "C" __global__ void sum_records(unsigned count, unsigned width, const dou
                            : 0.0;
 }
 
+// The largest of the terms at[0], at[step], at[2 step], … below `end`.
+static __device__ __forceinline__ double strided_max(const double* at, size_t end, size_t step,
+                                                     double lowest) {
+    double m = lowest;
+    for (size_t k = 0; k < end; k += step) {
+        m = fmax(m, at[k]);
+    }
+    return m;
+}
+
+// As sum_records, each column's largest instead of its sum (`lowest` where a group
+// has no record).
+extern "C" __global__ void max_records(unsigned count, unsigned width, const double* in,
+                                       unsigned groups, double* out, unsigned offset,
+                                       double lowest) {
+    unsigned g = blockIdx.x * blockDim.x + threadIdx.x;
+    if (g >= groups * width) {
+        return;
+    }
+    unsigned t = g / width, c = g % width;
+    size_t first = (size_t)width * t + c;
+    out[offset + first] = count > t ? strided_max(in + first, (size_t)width * (count - t),
+                                                  (size_t)width * groups, lowest)
+                                    : lowest;
+}
+
 // The first pass over the pairs' energy terms (spheres.cu): thread t of `groups`
 // sums the elastic energy and the dissipation of pairs t, t + groups, … into record
 // t of `records` (ENERGY_RECORD doubles: energy, dissipated, wall contacts = 0, the

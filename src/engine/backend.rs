@@ -44,7 +44,7 @@ use super::rank::Share;
 use super::stats::{StageTimes, StepStats};
 use crate::Real;
 use crate::contact::TangentialHistory;
-use crate::world::World;
+use crate::world::{RunFigures, World};
 
 /// Key of a particle–wall contact patch: particle id, wall, and the patch plane
 /// (normal and offset rounded), so that friction history survives sliding from facet
@@ -134,6 +134,15 @@ pub trait Backend: Send + fmt::Debug {
     /// steps the host world itself; a device backend holds them on the device).
     fn particles_on_host(&self) -> bool {
         true
+    }
+
+    /// The figures of the owned particles computed where they live, for a backend
+    /// whose particles are not on the host: what [`RunFigures::of`] gives of the
+    /// host world once the particles are copied to it (the sums in another order,
+    /// round-off apart). `None` where the backend does not compute them: the host
+    /// copies the particles back to compute them itself.
+    fn particle_figures(&mut self) -> Option<RunFigures> {
+        None
     }
 
     /// Where the host's world is one rank's share of a decomposed run: the other

@@ -50,13 +50,7 @@ impl HeldEnergy {
 
     /// Kinetic and potential energy of the particles in `range` (no elastic energy).
     pub fn of_particles(world: &World, range: std::ops::Range<usize>) -> Self {
-        let p = &world.particles;
-        let (mut kinetic, mut potential) = (0.0, 0.0);
-        for i in range {
-            kinetic += world.particle_kinetic_energy(i);
-            let mass = world.body_types[p.body_type[i] as usize].mass;
-            potential -= mass * world.gravity.dot(&p.position[i].coords);
-        }
+        let (kinetic, potential) = world.kinetic_and_potential(range);
         HeldEnergy {
             kinetic,
             potential,

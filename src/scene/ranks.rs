@@ -30,66 +30,13 @@ use crate::engine::decomposition::Decomposition;
 use crate::engine::exchange::Exchange;
 use crate::engine::rank::{ParticleRecord, Share, all_gather, gather_to_first};
 use crate::engine::{ContactHistory, StepStats};
+pub use crate::world::RunFigures;
 use crate::world::{MassMoments, Particles, World};
 
 /// The ranks bisect the space again at a list renewal where the most loaded rank's
 /// cost exceeds the mean by this factor: a fifth more work on one rank costs a
 /// fifth of the step, a new bisection moves a share of the particles once.
 pub const REBALANCE_ABOVE: Real = 1.2;
-
-/// Figures of the whole run's particles (of a world's owned particles, or summed
-/// over the ranks).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct RunFigures {
-    /// Particles.
-    pub particles: usize,
-    /// Of them, frozen.
-    pub frozen: usize,
-    /// Their mass and its first moment.
-    pub moments: MassMoments,
-    /// Kinetic energy, J.
-    pub kinetic: Real,
-    /// Potential energy in gravity (zero at the origin), J.
-    pub potential: Real,
-    /// Largest speed, m/s.
-    pub max_speed: Real,
-    /// Corners of the box around the centroids (inverted when there is none).
-    pub lower: Point3<Real>,
-    pub upper: Point3<Real>,
-    /// The smallest id of a particle whose state is not finite.
-    pub non_finite: Option<u64>,
-}
-
-impl RunFigures {
-    /// The figures of `world`'s owned particles.
-    pub fn of(world: &World) -> Self {
-        let p = &world.particles;
-        let n = p.owned();
-        let held = HeldEnergy::of_particles(world, 0..n);
-        let mut lower = Point3::from([Real::INFINITY; 3]);
-        let mut upper = Point3::from([Real::NEG_INFINITY; 3]);
-        for x in &p.position[..n] {
-            lower = lower.inf(x);
-            upper = upper.sup(x);
-        }
-        let non_finite = if p.all_finite() {
-            None
-        } else {
-            (0..n).filter(|&i| !p.is_finite(i)).map(|i| p.id[i]).min()
-        };
-        RunFigures {
-            particles: n,
-            frozen: p.frozen_count(),
-            moments: world.mass_moments(),
-            kinetic: held.kinetic,
-            potential: held.potential,
-            max_speed: world.max_speed(),
-            lower,
-            upper,
-            non_finite,
-        }
-    }
-}
 
 /// What a rank's host knows of the whole run after a step.
 #[derive(Clone, Copy, Debug)]
@@ -208,7 +155,11 @@ impl Simulation {
             let Some(share) = self.backend.share() else {
                 return (inserted, freezing);
             };
-            let mine = Shares::of(&self.world, &local, &inserted, freezing);
+            let figures = match self.backend_figures {
+                Some(figures) if self.particles_behind => figures,
+                _ => RunFigures::of(&self.world),
+            };
+            let mine = Shares::of(&self.world, figures, &local, &inserted, freezing);
             let all = all_gather(share, &mine.0).into_iter().map(Shares);
             all.reduce(Shares::fold).expect("at least one rank")
         };
@@ -227,8 +178,14 @@ const MAXIMA: usize = 4;
 const MINIMA: usize = 4;
 
 impl Shares {
-    fn of(world: &World, stats: &StepStats, inserted: &HeldEnergy, freezing: Real) -> Self {
-        let f = RunFigures::of(world);
+    /// `f`: the figures of this rank's particles.
+    fn of(
+        world: &World,
+        f: RunFigures,
+        stats: &StepStats,
+        inserted: &HeldEnergy,
+        freezing: Real,
+    ) -> Self {
         let mut v = vec![
             stats.contacts as Real,
             stats.pair_contacts as Real,

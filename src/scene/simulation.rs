@@ -52,6 +52,9 @@ pub struct Simulation {
     particles_each_step: bool,
     /// Whether the backend holds particle state the host world has not received.
     pub(super) particles_behind: bool,
+    /// On ranks, where the particles are behind: the backend's figures of its
+    /// owned particles after the last step (see [`Backend::particle_figures`]).
+    pub(super) backend_figures: Option<RunFigures>,
 }
 
 /// Simulated time between two measurements of the bed height (while inlets feed
@@ -129,6 +132,7 @@ impl Simulation {
             whole: None,
             particles_each_step: true,
             particles_behind: false,
+            backend_figures: None,
         }
     }
 
@@ -360,6 +364,10 @@ impl Simulation {
         let before = self.world.time;
         self.backend.step(&mut self.world, dt);
         self.particles_behind = !self.backend.particles_on_host();
+        self.backend_figures = None;
+        if self.particles_behind && self.backend.share().is_some() {
+            self.backend_figures = self.backend.particle_figures();
+        }
         if self.particles_each_step || self.reads_particles_between_steps(before) {
             self.sync_particles();
         }
@@ -383,10 +391,10 @@ impl Simulation {
     /// Whether the host's work after the step that began at `before` reads or changes
     /// the particles: inlets still inserting, the bed measured, the settling test, a
     /// fluid, and on ranks the whole run's figures, reduced every step from each
-    /// rank's particles (`ranks.rs`; the CPU backend steps the host world itself,
-    /// so nothing is copied there).
+    /// rank's particles where the backend does not give them (`ranks.rs`; the CPU
+    /// backend steps the host world itself, so nothing is copied there).
     fn reads_particles_between_steps(&self, before: Real) -> bool {
-        self.backend.share().is_some()
+        self.backend.share().is_some() && self.backend_figures.is_none()
             || !self.inlets_done()
             || self.bed_measured_after(before)
             || self.settle.is_some()

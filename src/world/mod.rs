@@ -2,6 +2,7 @@
 //! types (shape and material, stored once), materials, and triangulated walls.
 
 mod cell_shares;
+mod figures;
 mod fluid;
 mod inlet;
 mod motion;
@@ -13,6 +14,7 @@ use std::ops::Range;
 use nalgebra::Vector3;
 
 pub use cell_shares::{CellShares, ShareRow};
+pub use figures::RunFigures;
 pub use fluid::{
     CellContribution, DragModel, FluidField, LocalFluid, MomentumExchange, ParticleFluid,
 };

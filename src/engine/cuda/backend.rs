@@ -27,7 +27,7 @@ use crate::engine::backend::{Backend, ContactHistory};
 use crate::engine::params::StepParams;
 use crate::engine::rank::ShareStepper;
 use crate::engine::stats::{StageTimes, StepStats};
-use crate::world::World;
+use crate::world::{RunFigures, World};
 
 /// The CUDA backend (see the module).
 pub struct CudaBackend {
@@ -265,6 +265,12 @@ impl Backend for CudaBackend {
 
     fn particles_on_host(&self) -> bool {
         false
+    }
+
+    /// From the device, when it holds a stepper.
+    fn particle_figures(&mut self) -> Option<RunFigures> {
+        let spheres = self.spheres.as_mut()?;
+        Some(spheres.particle_figures().unwrap_or_else(|e| fail(e)))
     }
 }
 

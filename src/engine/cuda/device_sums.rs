@@ -43,6 +43,15 @@ pub(super) fn first_rows(terms: usize) -> usize {
     terms.div_ceil(FIRST_FAN_IN).max(1)
 }
 
+/// How a pass folds rows into one.
+#[derive(Clone, Copy, Debug)]
+pub(super) enum Fold {
+    /// Each column's sum.
+    Sum,
+    /// Each column's largest, `lowest` where there is no row.
+    Max { lowest: Real },
+}
+
 /// The rows of a sum on the device, in two arrays used in turn.
 #[derive(Debug, Default)]
 pub(super) struct RowSums {
@@ -73,6 +82,19 @@ impl RowSums {
     pub fn fold(
         &mut self,
         device: &mut dyn Device,
+        rows: usize,
+        width: usize,
+        out: &Array<Real>,
+        at: usize,
+    ) -> Result<(), DeviceError> {
+        self.fold_by(Fold::Sum, device, rows, width, out, at)
+    }
+
+    /// [`fold`](Self::fold) by `fold`: each column's sum, or its largest.
+    pub fn fold_by(
+        &mut self,
+        fold: Fold,
+        device: &mut dyn Device,
         mut rows: usize,
         width: usize,
         out: &Array<Real>,
@@ -87,22 +109,29 @@ impl RowSums {
         loop {
             let g = groups(rows);
             let (into, offset) = if g == 1 { (out, at) } else { (&self.folded, 0) };
-            // SAFETY: the parameters of sum_records (sums.cu): `rows` holds `rows`
-            // rows of `width`, `into` room for `g`.
+            let (kernel, lowest) = match fold {
+                Fold::Sum => (Kernel::SumRecords, None),
+                Fold::Max { lowest } => (Kernel::MaxRecords, Some(Arg::F64(lowest))),
+            };
+            let args = [
+                Arg::U32(rows as u32),
+                Arg::U32(width as u32),
+                self.rows.arg(),
+                Arg::U32(g as u32),
+                into.arg(),
+                Arg::U32(offset as u32),
+                lowest.unwrap_or(Arg::U32(0)),
+            ];
+            let args = if lowest.is_some() {
+                &args[..]
+            } else {
+                &args[..6]
+            };
+            // SAFETY: the parameters of sum_records, or of max_records with its
+            // lowest value (sums.cu): `rows` holds `rows` rows of `width`, `into`
+            // room for `g`.
             unsafe {
-                run(
-                    device,
-                    Kernel::SumRecords,
-                    g * width,
-                    &[
-                        Arg::U32(rows as u32),
-                        Arg::U32(width as u32),
-                        self.rows.arg(),
-                        Arg::U32(g as u32),
-                        into.arg(),
-                        Arg::U32(offset as u32),
-                    ],
-                )?;
+                run(device, kernel, g * width, args)?;
             }
             if g == 1 {
                 return Ok(());

@@ -51,7 +51,7 @@ pub static CONTACT: KernelFile = KernelFile {
 };
 
 /// The kernel files, each compiled to one module.
-pub static FILES: [KernelFile; 7] = [
+pub static FILES: [KernelFile; 8] = [
     KernelFile {
         name: "integrate.cu",
         source: include_str!("../../../kernels/integrate.cu"),
@@ -85,6 +85,11 @@ pub static FILES: [KernelFile; 7] = [
     KernelFile {
         name: "halo.cu",
         source: include_str!("../../../kernels/halo.cu"),
+        headers: &[&VEC, &CONTACT],
+    },
+    KernelFile {
+        name: "figures.cu",
+        source: include_str!("../../../kernels/figures.cu"),
         headers: &[&VEC, &CONTACT],
     },
 ];
@@ -146,11 +151,15 @@ pub enum Kernel {
     PackStates,
     /// The ghosts' states received, unpacked into their slots (`halo.cu`).
     UnpackGhostStates,
+    /// A pass of the deterministic sums taking each column's largest (`sums.cu`).
+    MaxRecords,
+    /// Each owned particle's share of the run's figures (`figures.cu`).
+    ParticleFigures,
 }
 
 impl Kernel {
     /// Every kernel.
-    pub const ALL: [Kernel; 27] = [
+    pub const ALL: [Kernel; 29] = [
         Kernel::KickDrift,
         Kernel::ClosingKick,
         Kernel::BinParticles,
@@ -178,6 +187,8 @@ impl Kernel {
         Kernel::SumRecords,
         Kernel::PackStates,
         Kernel::UnpackGhostStates,
+        Kernel::MaxRecords,
+        Kernel::ParticleFigures,
     ];
 
     /// Its name in the source (`extern "C"`, so the PTX entry has it too).
@@ -210,6 +221,8 @@ impl Kernel {
             Kernel::SumRecords => "sum_records",
             Kernel::PackStates => "pack_states",
             Kernel::UnpackGhostStates => "unpack_ghost_states",
+            Kernel::MaxRecords => "max_records",
+            Kernel::ParticleFigures => "particle_figures",
         }
     }
 
@@ -225,8 +238,9 @@ impl Kernel {
             ScanChunkTotals | ScanChunkOffsets | ScanApply | ZeroWords | CopyWords => 2,
             SphereContacts | GatherForces => 3,
             SphereWalls | WallSumRows | WallEnergyTerms => 4,
-            PairEnergyPartials | SumRecords => 5,
+            PairEnergyPartials | SumRecords | MaxRecords => 5,
             PackStates | UnpackGhostStates => 6,
+            ParticleFigures => 7,
         };
         &FILES[index]
     }

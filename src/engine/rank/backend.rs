@@ -18,7 +18,7 @@ use crate::engine::backend::{Backend, ContactHistory};
 use crate::engine::exchange::Exchange;
 use crate::engine::params::StepParams;
 use crate::engine::stats::{StageTimes, StepStats};
-use crate::world::World;
+use crate::world::{RunFigures, World};
 
 impl<E: Exchange + Send + fmt::Debug, B: ShareStepper> Backend for RankStepper<E, B> {
     fn name(&self) -> &'static str {
@@ -102,6 +102,11 @@ impl<E: Exchange + Send + fmt::Debug, B: ShareStepper> Backend for RankStepper<E
 
     fn particles_on_host(&self) -> bool {
         self.backend.particles_on_host()
+    }
+
+    /// This rank's share.
+    fn particle_figures(&mut self) -> Option<RunFigures> {
+        self.backend.particle_figures()
     }
 
     fn share(&self) -> Option<&dyn Share> {

@@ -25,6 +25,7 @@
 
 use nalgebra::{Point3, UnitQuaternion, Vector3};
 
+mod figures;
 mod halo;
 mod transfer;
 
@@ -120,6 +121,8 @@ pub struct DeviceSpheres {
     stale: Option<bool>,
     /// The halo's slots and state records (`halo.rs`).
     halo: halo::HaloArrays,
+    /// Scratch of the particles' figures (`figures.rs`).
+    figures: figures::FigureSums,
     gravity: Vector3<Real>,
     time: Real,
     types: TypeArrays,
@@ -253,6 +256,7 @@ impl DeviceSpheres {
             owned: p.owned(),
             stale: None,
             halo: Default::default(),
+            figures: Default::default(),
             gravity: world.gravity,
             time: world.time,
             types,
