@@ -567,7 +567,11 @@ fn the_figures_of_the_owned_particles_are_the_hosts() {
         spheres.step(dt).unwrap();
     }
     spheres.download(&mut start).unwrap();
+    let before = spheres.device_bytes();
     let (device, host_figures) = (spheres.particle_figures().unwrap(), RunFigures::of(&start));
+    // The figures' scratch is counted: two records of 8 doubles a sphere.
+    let n = start.particles.len();
+    assert!(spheres.device_bytes() >= before + 128 * n);
     assert_eq!(device.particles, start.particles.owned());
     assert_eq!(
         (device.particles, device.frozen, device.max_speed),

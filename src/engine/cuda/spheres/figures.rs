@@ -26,6 +26,13 @@ pub(super) struct FigureSums {
     out: Array<Real>,
 }
 
+impl FigureSums {
+    /// Device memory held, bytes.
+    pub(super) fn bytes(&self, device: &dyn crate::engine::cuda::device::Device) -> usize {
+        self.sums.bytes(device) + self.extrema.bytes(device) + self.out.bytes(device)
+    }
+}
+
 impl DeviceSpheres {
     /// The figures of the owned particles ([`RunFigures::of`] of the host world
     /// the particles would be copied to; the sums in a tree, round-off apart from

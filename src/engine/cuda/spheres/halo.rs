@@ -22,6 +22,13 @@ pub(super) struct HaloArrays {
     records: Array<Real>,
 }
 
+impl HaloArrays {
+    /// Device memory held, bytes.
+    pub(super) fn bytes(&self, device: &dyn crate::engine::cuda::device::Device) -> usize {
+        self.slots.bytes(device) + self.records.bytes(device)
+    }
+}
+
 impl DeviceSpheres {
     /// Copies the motion state (position, orientation, velocity, angular momentum)
     /// of the host entries `entries` (owned particles sent as ghosts) into `world`.

@@ -13,8 +13,8 @@ use crate::world::World;
 
 impl DeviceSpheres {
     /// Bytes of device memory the stepper holds: particles, body types, the list,
-    /// the pairs' history and results, the walls (buffers have room to grow by
-    /// half).
+    /// the pairs' history and results, the walls, and on a rank its halo and the
+    /// scratch of its figures (buffers have room to grow by half).
     pub fn device_bytes(&self) -> usize {
         let d = self.device.as_ref();
         let (p, t, q) = (&self.particles, &self.types, &self.pairs);
@@ -48,6 +48,8 @@ impl DeviceSpheres {
             + self.walls.bytes(d)
             + self.sums.bytes(d)
             + self.readback.device.bytes(d)
+            + self.halo.bytes(d)
+            + self.figures.bytes(d)
     }
 
     /// The elastic energy held in the contacts and the energy they dissipated over
