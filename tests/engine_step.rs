@@ -360,3 +360,51 @@ fn a_frozen_particle_carries_a_free_one_and_never_moves() {
     assert!(delta > 0.0 && delta < 0.02 * r, "overlap {delta}");
     assert!((p.position[2].xy() - base.xy()).norm() < 1e-9);
 }
+
+/// A pair that parts lets its friction spring go: in the step the two spheres come
+/// apart, the stored spring energy is booked as dissipated (no walls here, so it is
+/// the step's whole dissipation, to the bit), and the pair keeps no history. On one
+/// thread (the fused sweep) and on two (the pair stage and the gather).
+#[test]
+fn a_parting_pair_lets_its_friction_spring_go() {
+    for threads in [1, 2] {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            let shape = Shape::Sphere(talus::geometry::Sphere::new(0.005).unwrap());
+            // Elastic, so that the normal force (and the friction cap with it) lasts
+            // until the spheres part: a dashpot would end it, and empty the spring,
+            // a few steps before.
+            let mut world = world_with(shape, 1.0, 0.5, 0.0);
+            world.walls.clear();
+            let rest = UnitQuaternion::identity();
+            world.particles.push(0, Point3::new(0.0, 0.0, 0.0), rest, 1);
+            world
+                .particles
+                .push(0, Point3::new(0.004, 0.0, 0.0105), rest, 2);
+            // An oblique impact: the spheres slide while they touch.
+            world.particles.velocity[1] = Vector3::new(-0.3, 0.0, -0.5);
+            let (mut engine, dt) = (CpuBackend::default(), 1e-6);
+            engine.initialise(&mut world, dt);
+            let mut held = None;
+            for step in 0..20_000 {
+                engine.step(&mut world, dt);
+                let history = engine.contact_history().pairs;
+                if engine.stats().contacts > 0 {
+                    // (The spring is empty at the first touch: it holds the slip of
+                    // the steps since.)
+                    assert!(history.len() <= 1, "step {step}: one pair");
+                    held = Some(history.first().map_or(0.0, |h| h.1.spring_energy()));
+                } else if let Some(spring) = held {
+                    assert!(spring > 0.0, "the spring is stretched when they part");
+                    assert!(history.is_empty(), "a parted pair keeps no history");
+                    assert_eq!(engine.stats().dissipated, spring, "{threads} thread(s)");
+                    return;
+                }
+            }
+            panic!("{threads} thread(s): the spheres never touched and parted");
+        });
+    }
+}

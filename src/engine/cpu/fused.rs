@@ -17,7 +17,7 @@
 //! (pairs are sorted by the first particle) and touches the second's in place.
 
 use super::contact_state::ContactState;
-use super::pairs::{ContactTotals, PairLaws, StartLoads, evaluate_pair};
+use super::pairs::{BLOCK, ContactTotals, PairLaws, StartLoads, busy_pairs, evaluate_pair};
 use super::prefetch::PlanPrefetch;
 use crate::Real;
 use crate::engine::neighbours::NeighbourList;
@@ -55,29 +55,51 @@ pub(super) fn pair_contacts_gathered(
     let mut spare = OverlapCache::default();
     let prefetch = PlanPrefetch::of(&state.overlap_plans);
     let mut totals = ContactTotals::default();
-    for (k, (&pair, history)) in list.pairs().iter().zip(&mut state.pair_history).enumerate() {
-        let plan = if with_plans {
+    let pairs = list.pairs();
+    for first in (0..pairs.len()).step_by(BLOCK) {
+        let block = first..pairs.len().min(first + BLOCK);
+        let mut busy = busy_pairs(
+            p,
+            radii,
+            &pairs[block.clone()],
+            &state.pair_history[block.clone()],
+        );
+        for k in block {
             prefetch.ahead(k);
-            &mut state.overlap_plans[k]
-        } else {
-            &mut spare
-        };
-        let c = evaluate_pair(world, radii, &laws, pair, history, plan);
-        for (particle, first) in [(pair[0] as usize, true), (pair[1] as usize, false)] {
-            // A ghost's sums stay zero (the gather leaves them so).
-            if particle < start.owned {
-                c.add_to(
-                    (
-                        &mut force[particle],
-                        &mut torque[particle],
-                        &mut touching[particle],
-                    ),
-                    first,
-                );
-            }
         }
-        totals.count(&world.particles, pair, &c);
+        while busy != 0 {
+            let k = first + busy.trailing_zeros() as usize;
+            busy &= busy - 1;
+            let plan = if with_plans {
+                &mut state.overlap_plans[k]
+            } else {
+                &mut spare
+            };
+            let pair = pairs[k];
+            let c = evaluate_pair(world, radii, &laws, pair, &mut state.pair_history[k], plan);
+            for (particle, first) in [(pair[0] as usize, true), (pair[1] as usize, false)] {
+                // A ghost's sums stay zero (the gather leaves them so).
+                if particle < start.owned {
+                    c.add_to(
+                        (
+                            &mut force[particle],
+                            &mut torque[particle],
+                            &mut touching[particle],
+                        ),
+                        first,
+                    );
+                }
+            }
+            totals.count(&world.particles, pair, &c);
+        }
     }
+    // A pair with nothing to do adds zeros to its particles and to the energies
+    // (`x + 0.0` is `x`; the totals start at +0 and so are never −0): only its
+    // count remains.
+    totals.candidates = pairs
+        .iter()
+        .filter(|&&[i, j]| p.counts_pair(i as usize, j as usize))
+        .count();
     world.particles.force = force;
     world.particles.torque = torque;
     totals
