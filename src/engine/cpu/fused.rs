@@ -17,7 +17,7 @@
 //! (pairs are sorted by the first particle) and touches the second's in place.
 
 use super::contact_state::ContactState;
-use super::pairs::{BLOCK, ContactTotals, PairLaws, StartLoads, busy_pairs, evaluate_pair};
+use super::pairs::{BLOCK, ContactTotals, PairLaws, StartLoads, evaluate_pair, to_evaluate};
 use super::prefetch::PlanPrefetch;
 use crate::Real;
 use crate::engine::neighbours::NeighbourList;
@@ -58,19 +58,18 @@ pub(super) fn pair_contacts_gathered(
     let pairs = list.pairs();
     for first in (0..pairs.len()).step_by(BLOCK) {
         let block = first..pairs.len().min(first + BLOCK);
-        let mut busy = busy_pairs(
+        let mut busy = to_evaluate(
+            !with_plans,
             p,
             radii,
             &pairs[block.clone()],
             &state.pair_history[block.clone()],
         );
-        for k in block {
-            prefetch.ahead(k);
-        }
         while busy != 0 {
             let k = first + busy.trailing_zeros() as usize;
             busy &= busy - 1;
             let plan = if with_plans {
+                prefetch.ahead(k);
                 &mut state.overlap_plans[k]
             } else {
                 &mut spare
