@@ -17,7 +17,8 @@
 //! (pairs are sorted by the first particle) and touches the second's in place.
 
 use super::contact_state::ContactState;
-use super::pairs::{BLOCK, ContactTotals, PairLaws, StartLoads, evaluate_pair, to_evaluate};
+use super::pair_results::{BLOCK, BusyBits};
+use super::pairs::{ContactTotals, PairLaws, StartLoads, evaluate_pair, to_evaluate};
 use super::prefetch::PlanPrefetch;
 use crate::Real;
 use crate::engine::neighbours::NeighbourList;
@@ -54,20 +55,18 @@ pub(super) fn pair_contacts_gathered(
     let with_plans = state.overlap_plans.len() == list.pairs().len();
     let mut spare = OverlapCache::default();
     let prefetch = PlanPrefetch::of(&state.overlap_plans);
-    let mut totals = ContactTotals::default();
     let pairs = list.pairs();
+    let mut totals = ContactTotals::of_candidates(p, pairs);
     for first in (0..pairs.len()).step_by(BLOCK) {
         let block = first..pairs.len().min(first + BLOCK);
-        let mut busy = to_evaluate(
+        let busy = to_evaluate(
             !with_plans,
             p,
             radii,
             &pairs[block.clone()],
             &state.pair_history[block.clone()],
         );
-        while busy != 0 {
-            let k = first + busy.trailing_zeros() as usize;
-            busy &= busy - 1;
+        for k in BusyBits(busy).map(|bit| first + bit) {
             let plan = if with_plans {
                 prefetch.ahead(k);
                 &mut state.overlap_plans[k]
@@ -92,13 +91,6 @@ pub(super) fn pair_contacts_gathered(
             totals.count(&world.particles, pair, &c);
         }
     }
-    // A pair with nothing to do adds zeros to its particles and to the energies
-    // (`x + 0.0` is `x`; the totals start at +0 and so are never −0): only its
-    // count remains.
-    totals.candidates = pairs
-        .iter()
-        .filter(|&&[i, j]| p.counts_pair(i as usize, j as usize))
-        .count();
     world.particles.force = force;
     world.particles.torque = torque;
     totals

@@ -24,6 +24,7 @@ mod forces;
 mod fused;
 mod hertz;
 pub(crate) mod motion;
+mod pair_results;
 mod pairs;
 mod patch;
 mod prefetch;
@@ -33,7 +34,7 @@ mod walls;
 use std::ops::Range;
 
 use self::contact_state::ContactState;
-use self::forces::PairResult;
+use self::pair_results::PairResults;
 use self::walls::{WallInputs, WallWork};
 use super::backend::{Backend, ContactHistory};
 use super::laws::ContactLaws;
@@ -49,8 +50,8 @@ use crate::world::World;
 struct Workspace {
     /// Bounding radius of every particle.
     radii: Vec<Real>,
-    /// The pair results, aligned with the pair list.
-    results: Vec<PairResult>,
+    /// The pair results of a step on many threads.
+    results: PairResults,
     /// Whether each particle touched another or a wall at the last force evaluation.
     touching: Vec<bool>,
     walls: WallWork,

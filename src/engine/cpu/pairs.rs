@@ -8,6 +8,7 @@ use super::contact_state::ContactState;
 use super::dispatch::pair_geometry;
 use super::forces::{ContactForce, PairResult, RelativeMotion, pair_force};
 use super::hertz::{HertzInputs, rolling_inertia, round_contact_force, round_radius, sphere_pair};
+use super::pair_results::{BLOCK, BusyBits, PairResults};
 use super::prefetch::PlanPrefetch;
 use crate::Real;
 use crate::contact::{RollingModel, TangentialHistory, effective_radius};
@@ -134,30 +135,25 @@ pub(super) fn evaluate_pair(
     }
 }
 
-/// Evaluates every candidate pair into `results` (aligned with the pairs), in
-/// parallel over blocks of pairs ([`evaluate_pair`] for the busy ones of each block,
-/// [`busy_pairs`]; the others' results are empty).
+/// Evaluates the candidate pairs into `results`, in parallel over blocks of pairs:
+/// [`evaluate_pair`] for the pairs of each block that [`to_evaluate`] names.
 pub(super) fn pair_contacts(
     world: &World,
     list: &NeighbourList,
     state: &mut ContactState,
     radii: &[Real],
     laws: PairLaws,
-    results: &mut Vec<PairResult>,
+    results: &mut PairResults,
 ) {
     let pairs = list.pairs();
-    results.resize(pairs.len(), PairResult::default());
     let evaluate_block = |first: usize,
-                          results: &mut [PairResult],
+                          (results, mask): (&mut [PairResult], &mut u64),
                           history: &mut [TangentialHistory],
                           mut plans: Option<(&mut [OverlapCache], PlanPrefetch)>,
                           spare: &mut OverlapCache| {
         let pairs = &pairs[first..first + results.len()];
-        let mut busy = to_evaluate(plans.is_none(), &world.particles, radii, pairs, history);
-        results.fill(PairResult::default());
-        while busy != 0 {
-            let k = busy.trailing_zeros() as usize;
-            busy &= busy - 1;
+        *mask = to_evaluate(plans.is_none(), &world.particles, radii, pairs, history);
+        for k in BusyBits(*mask) {
             let plan = match &mut plans {
                 Some((plans, prefetch)) => {
                     prefetch.ahead(first + k);
@@ -169,7 +165,7 @@ pub(super) fn pair_contacts(
         }
     };
     let blocks = results
-        .par_chunks_mut(BLOCK)
+        .blocks_mut(pairs.len())
         .zip(state.pair_history.par_chunks_mut(BLOCK))
         .enumerate();
     if state.overlap_plans.len() == pairs.len() {
@@ -189,9 +185,6 @@ pub(super) fn pair_contacts(
         });
     }
 }
-
-/// Pairs per block of the pair stage: one bit each in the block's mask of busy pairs.
-pub(super) const BLOCK: usize = 64;
 
 /// The mask of the pairs of a block to evaluate (at most [`BLOCK`], with their
 /// `history`): the busy ones ([`busy_pairs`]) if `sift`, else all of them (an
@@ -217,9 +210,9 @@ pub(super) fn to_evaluate(
 /// The mask of the pairs of a block (at most [`BLOCK`], with their `history`) that
 /// have something to do: their bounding spheres overlap and one of them moves (the
 /// test [`evaluate_pair`] starts with), or their contact held a history that
-/// parting lets go. Found without a branch per pair: whether a pair touches is as good as a
-/// coin toss in a dense bed, and a mispredicted branch for every other candidate
-/// pair cost the sweep about a tenth of its time.
+/// parting lets go. Found without a branch per pair: whether a pair touches is as
+/// good as a coin toss in a dense bed, and a mispredicted branch for every other
+/// candidate pair cost the sweep about a tenth of its time.
 #[inline]
 fn busy_pairs(
     p: &Particles,
@@ -246,7 +239,7 @@ fn busy_pairs(
 pub(super) fn gather(
     world: &mut World,
     list: &NeighbourList,
-    results: &[PairResult],
+    results: &PairResults,
     touching: &mut Vec<bool>,
 ) -> ContactTotals {
     let p = &mut world.particles;
@@ -271,14 +264,15 @@ pub(super) fn gather(
             // Adding a pair apart adds zeros: `x + 0.0` is `x`, and `x + (−1)·f` is
             // `x − f`, so the sums are those of adding the touching pairs alone.
             for &e in list.incident(k) {
-                let c = &results[e.pair()];
+                let c = results.get(e.pair());
                 c.add_to((force, torque, touching), e.is_first());
             }
         });
     let p = &world.particles;
-    let mut totals = ContactTotals::default();
-    for (c, &[i, j]) in results.iter().zip(list.pairs()) {
-        totals.count(p, [i, j], c);
+    let pairs = list.pairs();
+    let mut totals = ContactTotals::of_candidates(p, pairs);
+    for (k, c) in results.busy() {
+        totals.count(p, pairs[k], c);
     }
     totals
 }
@@ -336,14 +330,27 @@ pub(super) struct ContactTotals {
 }
 
 impl ContactTotals {
+    /// No contacts yet, and the candidate pairs among `pairs` that this world counts
+    /// (see [`Particles::counts_pair`]).
+    pub(super) fn of_candidates(p: &Particles, pairs: &[[u32; 2]]) -> Self {
+        ContactTotals {
+            candidates: pairs
+                .iter()
+                .filter(|&&[i, j]| p.counts_pair(i as usize, j as usize))
+                .count(),
+            ..Default::default()
+        }
+    }
+
     /// Adds pair `[i, j]`'s result if this world counts the pair (see
-    /// [`Particles::counts_pair`]); called in pair order.
+    /// [`Particles::counts_pair`]); called in pair order. A pair with nothing to do
+    /// may be left out: it adds zeros (`x + 0.0` is `x`, and the sums start at +0,
+    /// so they are never −0).
     #[inline]
     pub(super) fn count(&mut self, p: &Particles, [i, j]: [u32; 2], c: &PairResult) {
         if !p.counts_pair(i as usize, j as usize) {
             return;
         }
-        self.candidates += 1;
         self.contacts += usize::from(c.touching);
         self.energy += c.energy;
         self.dissipated += c.dissipated;
