@@ -364,11 +364,19 @@ impl Simulation {
         let before = self.world.time;
         self.backend.step(&mut self.world, dt);
         self.particles_behind = !self.backend.particles_on_host();
+        // On ranks the whole run's figures are reduced every step: from the host's
+        // particles when they are brought up anyway, else from what the backend
+        // computes where the particles live, and from the host's only where it
+        // cannot (the CPU backend steps the host world: nothing is copied there).
         self.backend_figures = None;
-        if self.particles_behind && self.backend.share().is_some() {
-            self.backend_figures = self.backend.particle_figures();
+        let mut sync = self.particles_each_step || self.reads_particles_between_steps(before);
+        if !sync && self.backend.share().is_some() {
+            if self.particles_behind {
+                self.backend_figures = self.backend.particle_figures();
+            }
+            sync = self.backend_figures.is_none();
         }
-        if self.particles_each_step || self.reads_particles_between_steps(before) {
+        if sync {
             self.sync_particles();
         }
         self.steps = self.steps.saturating_add(1);
@@ -390,12 +398,9 @@ impl Simulation {
 
     /// Whether the host's work after the step that began at `before` reads or changes
     /// the particles: inlets still inserting, the bed measured, the settling test, a
-    /// fluid, and on ranks the whole run's figures, reduced every step from each
-    /// rank's particles where the backend does not give them (`ranks.rs`; the CPU
-    /// backend steps the host world itself, so nothing is copied there).
+    /// fluid (the figures on ranks are decided in [`Self::step_by`]).
     fn reads_particles_between_steps(&self, before: Real) -> bool {
-        self.backend.share().is_some() && self.backend_figures.is_none()
-            || !self.inlets_done()
+        !self.inlets_done()
             || self.bed_measured_after(before)
             || self.settle.is_some()
             || self.world.fluid.is_some()
