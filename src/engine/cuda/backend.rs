@@ -45,6 +45,8 @@ pub struct CudaBackend {
     integrated: usize,
     /// Steppers made from the whole host world.
     made: u64,
+    /// The owned entries a step sends to other ranks, sorted (kept between steps).
+    sent: Vec<usize>,
 }
 
 impl fmt::Debug for CudaBackend {
@@ -103,6 +105,7 @@ impl CudaBackend {
             touching: Vec::new(),
             integrated: 0,
             made: 0,
+            sent: Vec::new(),
         }
     }
 
@@ -288,13 +291,16 @@ impl ShareStepper for CudaBackend {
 
     /// The sent particles' states, each once, from the device.
     fn owned_to_host(&mut self, world: &mut World, sends: &[Vec<usize>]) {
-        let mut entries = sends.concat();
-        entries.sort_unstable();
-        entries.dedup();
+        let mut sent = std::mem::take(&mut self.sent);
+        sent.clear();
+        sent.extend(sends.iter().flatten());
+        sent.sort_unstable();
+        sent.dedup();
         let spheres = self.stepper(world);
         spheres
-            .states_to_host(world, &entries)
+            .states_to_host(world, &sent)
             .unwrap_or_else(|e| fail(e));
+        self.sent = sent;
     }
 
     fn ghosts_from_host(&mut self, world: &World) {

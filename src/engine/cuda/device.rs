@@ -321,15 +321,24 @@ impl<T: Pod> Array<T> {
 
     /// The elements.
     pub fn read(&self, device: &dyn Device) -> Result<Vec<T>, DeviceError> {
-        let mut out = vec![T::zeroed(); self.len];
+        let mut out = Vec::new();
+        self.read_into(device, &mut out)?;
+        Ok(out)
+    }
+
+    /// The elements, into `out` (its buffer kept, so a read of the same length
+    /// allocates nothing).
+    pub fn read_into(&self, device: &dyn Device, out: &mut Vec<T>) -> Result<(), DeviceError> {
+        out.clear();
+        out.resize(self.len, T::zeroed());
         if self.len > 0 {
             device.download(
                 self.buffer.expect("sized"),
                 0,
-                bytemuck::cast_slice_mut(&mut out),
+                bytemuck::cast_slice_mut(out),
             )?;
         }
-        Ok(out)
+        Ok(())
     }
 
     /// Element `k`.

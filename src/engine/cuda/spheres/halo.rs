@@ -15,11 +15,14 @@ use crate::world::World;
 /// orientation (i, j, k, w), velocity, angular momentum, frozen.
 const HALO: usize = 14;
 
-/// The device slots of a halo transfer and its state records.
+/// The device slots of a halo transfer and its state records, with the host's copies
+/// (kept between steps: a step's halo allocates nothing once they have grown).
 #[derive(Debug, Default)]
 pub(super) struct HaloArrays {
     slots: Array<u32>,
     records: Array<Real>,
+    host_slots: Vec<u32>,
+    host_records: Vec<Real>,
 }
 
 impl HaloArrays {
@@ -40,9 +43,12 @@ impl DeviceSpheres {
         if entries.is_empty() {
             return Ok(());
         }
-        let slots: Vec<u32> = entries.iter().map(|&i| self.slot_of[i]).collect();
         let (d, a, h) = (self.device.as_mut(), &self.particles, &mut self.halo);
-        h.slots.write(d, &slots)?;
+        h.host_slots.clear();
+        h.host_slots
+            .extend(entries.iter().map(|&i| self.slot_of[i]));
+        let slots = &h.host_slots;
+        h.slots.write(d, slots)?;
         h.records.resize(d, HALO * slots.len())?;
         // SAFETY: the parameters of pack_states (halo.cu): the slots index the
         // particles' arrays, the records hold a record per slot.
@@ -63,8 +69,9 @@ impl DeviceSpheres {
                 ],
             )?;
         }
+        h.records.read_into(d, &mut h.host_records)?;
         let p = &mut world.particles;
-        for (&i, r) in entries.iter().zip(h.records.read(d)?.chunks_exact(HALO)) {
+        for (&i, r) in entries.iter().zip(h.host_records.chunks_exact(HALO)) {
             p.position[i] = Point3::new(r[0], r[1], r[2]);
             p.orientation[i] =
                 UnitQuaternion::new_unchecked(Quaternion::new(r[6], r[3], r[4], r[5]));
@@ -82,20 +89,21 @@ impl DeviceSpheres {
         if ghosts.is_empty() {
             return Ok(());
         }
-        let slots: Vec<u32> = ghosts.clone().map(|i| self.slot_of[i]).collect();
-        let records: Vec<Real> = ghosts
-            .flat_map(|i| {
-                let (x, q) = (p.position[i], p.orientation[i].coords);
-                let (v, l) = (p.velocity[i], p.angular_momentum[i]);
-                let frozen = if p.frozen[i] { 1.0 } else { 0.0 };
-                [
-                    x.x, x.y, x.z, q[0], q[1], q[2], q[3], v.x, v.y, v.z, l.x, l.y, l.z, frozen,
-                ]
-            })
-            .collect();
         let (d, a, h) = (self.device.as_mut(), &self.particles, &mut self.halo);
-        h.slots.write(d, &slots)?;
-        h.records.write(d, &records)?;
+        h.host_slots.clear();
+        h.host_slots.extend(ghosts.clone().map(|i| self.slot_of[i]));
+        h.host_records.clear();
+        h.host_records.extend(ghosts.flat_map(|i| {
+            let (x, q) = (p.position[i], p.orientation[i].coords);
+            let (v, l) = (p.velocity[i], p.angular_momentum[i]);
+            let frozen = if p.frozen[i] { 1.0 } else { 0.0 };
+            [
+                x.x, x.y, x.z, q[0], q[1], q[2], q[3], v.x, v.y, v.z, l.x, l.y, l.z, frozen,
+            ]
+        }));
+        let slots = &h.host_slots;
+        h.slots.write(d, slots)?;
+        h.records.write(d, &h.host_records)?;
         // SAFETY: the parameters of unpack_ghost_states (halo.cu): the slots index
         // the particles' arrays, the records hold a record per slot.
         unsafe {
