@@ -5,9 +5,9 @@
 //! # Same bits as the two stages
 //! The gather adds a particle's pairs in ascending pair order, starting from its
 //! weight; a sweep over the pairs in order reaches every particle's pairs in that
-//! same order, so each particle gets the same additions in the same order (pairs
-//! apart included: they add zeros, as in the gather), and the totals are summed in
-//! pair order as the gather sums them. A run on one thread is therefore bit for bit
+//! same order, so each particle gets the same additions in the same order (the
+//! pairs with nothing to do are skipped: in the gather they add zeros), and the
+//! totals are summed in pair order as the gather sums them. A run on one thread is therefore bit for bit
 //! a run on many (`tests/thread_count.rs`).
 //!
 //! # Why
@@ -17,8 +17,8 @@
 //! (pairs are sorted by the first particle) and touches the second's in place.
 
 use super::contact_state::ContactState;
-use super::pair_results::{BLOCK, BusyBits};
-use super::pairs::{ContactTotals, PairLaws, StartLoads, evaluate_pair, to_evaluate};
+use super::pair_results::BLOCK;
+use super::pairs::{BlockPlans, ContactTotals, PairLaws, StartLoads, evaluate_block};
 use super::prefetch::PlanPrefetch;
 use crate::Real;
 use crate::engine::neighbours::NeighbourList;
@@ -59,37 +59,38 @@ pub(super) fn pair_contacts_gathered(
     let mut totals = ContactTotals::of_candidates(p, pairs);
     for first in (0..pairs.len()).step_by(BLOCK) {
         let block = first..pairs.len().min(first + BLOCK);
-        let busy = to_evaluate(
-            !with_plans,
-            p,
+        let plans = with_plans.then(|| BlockPlans {
+            plans: &mut state.overlap_plans[block.clone()],
+            prefetch,
+            first,
+        });
+        let block_pairs = &pairs[block.clone()];
+        let history = &mut state.pair_history[block];
+        evaluate_block(
+            world,
             radii,
-            &pairs[block.clone()],
-            &state.pair_history[block.clone()],
-        );
-        for k in BusyBits(busy).map(|bit| first + bit) {
-            let plan = if with_plans {
-                prefetch.ahead(k);
-                &mut state.overlap_plans[k]
-            } else {
-                &mut spare
-            };
-            let pair = pairs[k];
-            let c = evaluate_pair(world, radii, &laws, pair, &mut state.pair_history[k], plan);
-            for (particle, first) in [(pair[0] as usize, true), (pair[1] as usize, false)] {
-                // A ghost's sums stay zero (the gather leaves them so).
-                if particle < start.owned {
-                    c.add_to(
-                        (
-                            &mut force[particle],
-                            &mut torque[particle],
-                            &mut touching[particle],
-                        ),
-                        first,
-                    );
+            &laws,
+            (block_pairs, history),
+            plans,
+            &mut spare,
+            |k, c| {
+                let pair = block_pairs[k];
+                for (particle, first) in [(pair[0] as usize, true), (pair[1] as usize, false)] {
+                    // A ghost's sums stay zero (the gather leaves them so).
+                    if particle < start.owned {
+                        c.add_to(
+                            (
+                                &mut force[particle],
+                                &mut torque[particle],
+                                &mut touching[particle],
+                            ),
+                            first,
+                        );
+                    }
                 }
-            }
-            totals.count(&world.particles, pair, &c);
-        }
+                totals.count(p, pair, &c);
+            },
+        );
     }
     world.particles.force = force;
     world.particles.torque = torque;
