@@ -217,7 +217,7 @@ pub(super) fn evaluate_block(
     for k in BusyBits(mask) {
         let plan = match &mut plans {
             Some(p) => {
-                p.prefetch.ahead(p.first + k);
+                p.prefetch.ahead(p.plans, p.first, k);
                 &mut p.plans[k]
             }
             None => &mut *spare,

@@ -294,6 +294,14 @@ impl OverlapCache {
     /// `decisions`.
     pub const HOT_BYTES: usize = std::mem::offset_of!(OverlapCache, decisions) + 1;
 
+    /// Whether the cache keeps a contact's decisions (a topology or a plan, beyond the
+    /// hot bytes), which the pair's next evaluation reads unless it moved too far:
+    /// a pair kept apart reads only [`Self::HOT_BYTES`].
+    #[inline]
+    pub fn keeps_contact(&self) -> bool {
+        self.slack.is_kept() && !matches!(self.decisions, Kept::Separated)
+    }
+
     /// The figures of the pair, where decisions are kept for these `shapes`.
     fn kept_for(&self, shapes: (usize, usize)) -> Option<PairFigures> {
         (self.slack.is_kept() && self.shapes == shapes).then_some(self.figures)
