@@ -7,7 +7,7 @@ mod common;
 use common::pose;
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 use talus::contact::{
-    DampingTable, NormalContact, TangentialHistory, normal_force, tangential_force,
+    DampingTable, NormalContact, Regularisation, TangentialHistory, normal_force, tangential_force,
 };
 use talus::geometry::ConvexPolyhedron;
 use talus::geometry::generators;
@@ -33,7 +33,7 @@ fn elastic(
                     relative_velocity: Vector3::zeros(),
                     effective_mass: 1.0,
                     stiffness: kappa,
-                    regularisation,
+                    regularisation: Regularisation::new(regularisation),
                     dt: 0.0,
                 },
                 &DampingTable::new(1.0),
@@ -140,7 +140,7 @@ fn realised_restitution(
                         relative_velocity: Vector3::new(0.0, 0.0, v),
                         effective_mass: mass,
                         stiffness: kappa,
-                        regularisation,
+                        regularisation: Regularisation::new(regularisation),
                         dt,
                     },
                     &table,

@@ -70,6 +70,6 @@ pub use hertz_mindlin::{
     HertzContact, HertzMindlinForce, HertzMindlinPair, effective_radius, hertz_mindlin_force,
 };
 pub use material::{Material, MaterialError, PairStiffness, pair_restitution};
-pub use normal::{NormalContact, NormalForce, normal_force};
+pub use normal::{NormalContact, NormalForce, Regularisation, normal_force};
 pub use rolling::{RollingContact, RollingModel, RollingParameters, rolling_torque};
 pub use tangential::{TangentialForce, TangentialHistory, tangential_force};

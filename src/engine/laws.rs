@@ -16,7 +16,8 @@
 use super::fast_hash::FastMap;
 use crate::Real;
 use crate::contact::{
-    DampingTable, HertzMindlinPair, PairStiffness, RollingParameters, pair_restitution,
+    DampingTable, HertzMindlinPair, PairStiffness, Regularisation, RollingParameters,
+    pair_restitution,
 };
 use crate::engine::RoundLaw;
 use crate::world::World;
@@ -30,7 +31,7 @@ pub(super) struct PairLaw {
     /// Coulomb friction coefficient (the mean of the materials').
     pub friction: Real,
     /// Regularisation volume `V₀` of the normal law.
-    pub regularisation: Real,
+    pub regularisation: Regularisation,
     /// Effective moment of inertia `1/(1/I₁ + 1/I₂)` (smallest principal moments).
     pub inertia: Real,
 }
@@ -42,7 +43,7 @@ struct TypeRow {
     stiffness: PairStiffness,
     /// `(l R)³`: the regularisation volume of a contact in which this type is the
     /// smaller body.
-    regularisation: Real,
+    regularisation: Regularisation,
     /// Smallest principal moment of inertia `I_min`, and its inverse.
     inertia: Real,
     inverse_inertia: Real,
@@ -145,7 +146,7 @@ impl ContactLaws {
                     normal: m.young / radius,
                     tangential: m.shear_modulus() / radius,
                 },
-                regularisation: (regularisation_length * radius).powi(3),
+                regularisation: Regularisation::of_length(regularisation_length * radius),
                 inertia: t.inertia.min(),
                 inverse_inertia: 1.0 / t.inertia.min(),
                 radius,
@@ -270,7 +271,7 @@ mod tests {
                 let law = laws.pair(i as u32, j as u32);
                 assert_eq!(law.stiffness, PairStiffness::particles(ma, ra, mb, rb));
                 assert_eq!(law.friction, 0.5 * (ma.friction + mb.friction));
-                assert_eq!(law.regularisation, (l * ra.min(rb)).powi(3));
+                assert_eq!(law.regularisation.volume(), (l * ra.min(rb)).powi(3));
                 assert_eq!(
                     law.inertia,
                     1.0 / (1.0 / a.inertia.min() + 1.0 / b.inertia.min())
@@ -283,7 +284,7 @@ mod tests {
                 let pm = &world.materials[a.material];
                 let r = a.shape.equivalent_radius();
                 assert_eq!(law.stiffness, PairStiffness::particle_wall(pm, r, wm));
-                assert_eq!(law.regularisation, (l * r).powi(3));
+                assert_eq!(law.regularisation.volume(), (l * r).powi(3));
                 assert_eq!(law.friction, 0.5 * (pm.friction + wm.friction));
             }
         }

@@ -7,8 +7,8 @@ use super::dispatch::ContactGeometry;
 pub(super) use super::relative_motion::RelativeMotion;
 use crate::Real;
 use crate::contact::{
-    DampingTable, NormalContact, PairStiffness, TangentialHistory, normal_force, rocking_damping,
-    tangential_force, twisting_friction,
+    DampingTable, NormalContact, PairStiffness, Regularisation, TangentialHistory, normal_force,
+    rocking_damping, tangential_force, twisting_friction,
 };
 use crate::engine::laws::{ContactLaws, PairLaw};
 use crate::world::World;
@@ -126,7 +126,7 @@ pub(super) struct LawInputs<'a> {
     pub damping: &'a DampingTable,
     pub friction: Real,
     /// Regularisation volume `V₀` of the normal law.
-    pub regularisation: Real,
+    pub regularisation: Regularisation,
     pub dt: Real,
 }
 
