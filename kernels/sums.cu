@@ -25,18 +25,32 @@ static __device__ __forceinline__ double strided_sum(const double* at, size_t en
     return (a0 + a1) + (a2 + a3);
 }
 
+// Thread g's share of a pass over `count` records of `width` doubles folded into
+// `groups`: column c of record t, whose terms are at `first`, `first + step`, …
+// below `end` (offsets into the records; none where t ≥ count). False for a thread
+// beyond the pass.
+static __device__ __forceinline__ bool record_column(unsigned count, unsigned width,
+                                                     unsigned groups, size_t* first,
+                                                     size_t* end, size_t* step) {
+    unsigned g = blockIdx.x * blockDim.x + threadIdx.x;
+    if (g >= groups * width) {
+        return false;
+    }
+    unsigned t = g / width, c = g % width;
+    *first = (size_t)width * t + c;
+    *end = count > t ? (size_t)width * (count - t) : 0;
+    *step = (size_t)width * groups;
+    return true;
+}
+
 // The records are written from double `offset` of `out`.
 extern "C" __global__ void sum_records(unsigned count, unsigned width, const double* in,
                                        unsigned groups, double* out, unsigned offset) {
-    unsigned g = blockIdx.x * blockDim.x + threadIdx.x;
-    if (g >= groups * width) {
-        return;
+    size_t first, end, step;
+    if (record_column(count, width, groups, &first, &end, &step)) {
+        // No term (end 0) sums to +0.
+        out[offset + first] = strided_sum(in + first, end, step);
     }
-    unsigned t = g / width, c = g % width;
-    size_t first = (size_t)width * t + c;
-    out[offset + first] = count > t ? strided_sum(in + first, (size_t)width * (count - t),
-                                         (size_t)width * groups)
-                           : 0.0;
 }
 
 // The largest of the terms at[0], at[step], at[2 step], … below `end`.
@@ -54,15 +68,10 @@ static __device__ __forceinline__ double strided_max(const double* at, size_t en
 extern "C" __global__ void max_records(unsigned count, unsigned width, const double* in,
                                        unsigned groups, double* out, unsigned offset,
                                        double lowest) {
-    unsigned g = blockIdx.x * blockDim.x + threadIdx.x;
-    if (g >= groups * width) {
-        return;
+    size_t first, end, step;
+    if (record_column(count, width, groups, &first, &end, &step)) {
+        out[offset + first] = strided_max(in + first, end, step, lowest);
     }
-    unsigned t = g / width, c = g % width;
-    size_t first = (size_t)width * t + c;
-    out[offset + first] = count > t ? strided_max(in + first, (size_t)width * (count - t),
-                                                  (size_t)width * groups, lowest)
-                                    : lowest;
 }
 
 // The first pass over the pairs' energy terms (spheres.cu): thread t of `groups`
