@@ -13,7 +13,7 @@ use std::path::Path;
 use std::process::ExitCode;
 
 mod common;
-use common::{GLASS_AND_STEEL_SPHERES, mpirun_self};
+use common::{GLASS_AND_STEEL_SPHERES, rank_report};
 
 use nalgebra::Vector3;
 use rand::{Rng, SeedableRng};
@@ -83,20 +83,7 @@ fn main() -> ExitCode {
 /// Runs this program under `mpirun -np 2` and `-np 3` and reads rank 0's report.
 fn launch_ranks() -> Result<(), String> {
     for ranks in [2, 3] {
-        let out = mpirun_self(ranks, RANK_MARK)?;
-        let stdout = String::from_utf8_lossy(&out.stdout);
-        if !out.status.success() {
-            return Err(format!(
-                "{ranks} ranks: {}\n{stdout}\n{}",
-                out.status,
-                String::from_utf8_lossy(&out.stderr)
-            ));
-        }
-        let report = format!("{ranks} ranks on devices:");
-        let line = stdout
-            .lines()
-            .find(|l| l.starts_with(&report))
-            .ok_or_else(|| format!("{ranks} ranks: no report in {stdout}"))?;
+        let line = rank_report(ranks, RANK_MARK, &format!("{ranks} ranks on devices:"))?;
         println!("{line}");
     }
     Ok(())

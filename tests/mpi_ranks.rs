@@ -13,7 +13,7 @@ use std::path::Path;
 use std::process::{Command, ExitCode};
 
 mod common;
-use common::mpirun_self;
+use common::rank_report;
 
 use nalgebra::Vector3;
 use rand::{Rng, SeedableRng};
@@ -59,20 +59,8 @@ fn main() -> ExitCode {
 /// Runs this program under `mpirun -np 1…4` and reads rank 0's report of each run.
 fn launch_ranks() -> Result<(), String> {
     for ranks in 1..=4 {
-        let out = mpirun_self(ranks, RANK_MARK)?;
-        let stdout = String::from_utf8_lossy(&out.stdout);
-        if !out.status.success() {
-            return Err(format!(
-                "{ranks} ranks: {}\n{stdout}\n{}",
-                out.status,
-                String::from_utf8_lossy(&out.stderr)
-            ));
-        }
         let report = format!("{ranks} ranks: 100 particles moved as one process");
-        let line = stdout
-            .lines()
-            .find(|l| l.starts_with(&report))
-            .ok_or_else(|| format!("{ranks} ranks: no report in {stdout}"))?;
+        let line = rank_report(ranks, RANK_MARK, &report)?;
         println!("{line}");
         let changed: usize = line
             .split('(')

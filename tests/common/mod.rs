@@ -227,6 +227,25 @@ pub fn mpirun_self(ranks: usize, mark: &str) -> Result<std::process::Output, Str
         .map_err(|e| format!("mpirun (openmpi-bin, scripts/system-deps.sh): {e}"))
 }
 
+/// Runs this test program on `ranks` ranks ([`mpirun_self`]) and returns the line of
+/// its output that starts with `report` (rank 0's), or why there is none.
+pub fn rank_report(ranks: usize, mark: &str, report: &str) -> Result<String, String> {
+    let out = mpirun_self(ranks, mark)?;
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    if !out.status.success() {
+        return Err(format!(
+            "{ranks} ranks: {}\n{stdout}\n{}",
+            out.status,
+            String::from_utf8_lossy(&out.stderr)
+        ));
+    }
+    stdout
+        .lines()
+        .find(|l| l.starts_with(report))
+        .map(str::to_string)
+        .ok_or_else(|| format!("{ranks} ranks: no report in {stdout}"))
+}
+
 /// The head of a scene of Hertz–Mindlin spheres: a step of 20 µs, gravity, glass
 /// and steel, big (5 mm) and small (4 mm) spheres; the particles and walls follow.
 pub const GLASS_AND_STEEL_SPHERES: &str = r#"
