@@ -22,8 +22,8 @@ pub struct NormalContact {
     pub effective_mass: Real,
     /// Normal stiffness factor κ of the pair (Pa/m).
     pub stiffness: Real,
-    /// Regularisation volume `V₀` (0 for the pure law): below it the potential is
-    /// quadratic in `V` (see [`normal_force`]).
+    /// Regularisation volume `V₀` (`Regularisation::new(0.0)` for the pure law): below
+    /// it the potential is quadratic in `V` (see [`normal_force`]).
     pub regularisation: Regularisation,
     /// Time step of the integration, or 0 for none. The damping force is capped at
     /// what stops the normal approach within one step, `m_eff |v_n| / dt`: the
@@ -33,9 +33,8 @@ pub struct NormalContact {
 }
 
 /// The regularisation volume `V₀` of the normal law with its cube root, which every
-/// contact's force and energy need: found once per pair of body types, not per
-/// contact (a cube root cost a contact of the dense dodecahedron bed about 3 % of
-/// its step).
+/// contact's force and energy need: found once per body type, not per contact (the
+/// cube roots of `V₀` were 3 % of a step of the dense dodecahedron bed).
 ///
 /// Invariant: `volume ≥ 0`, and `cbrt` is its cube root (to round-off).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
