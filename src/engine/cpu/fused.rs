@@ -7,8 +7,8 @@
 //! weight; a sweep over the pairs in order reaches every particle's pairs in that
 //! same order, so each particle gets the same additions in the same order (the
 //! pairs with nothing to do are skipped: in the gather they add zeros), and the
-//! totals are summed in pair order as the gather sums them. A run on one thread is therefore bit for bit
-//! a run on many (`tests/thread_count.rs`).
+//! totals are summed in pair order as the gather sums them. A run on one thread is
+//! therefore bit for bit a run on many (`tests/thread_count.rs`).
 //!
 //! # Why
 //! On one thread the results array is pure traffic: every pair's 88-byte result is
