@@ -44,11 +44,13 @@
 //! vertices of each face, its [`topology`]; the geometry is then evaluated from it,
 //! each vertex by one edge cut. A pair evaluated step after step keeps these
 //! decisions in an [`OverlapCache`] with how far the closest test was from going the
-//! other way (vertex–plane tests, and edge–edge distances for the topology); until
-//! the pair has moved that far, they cannot change, and only the evaluation is done
-//! again ([`overlap_cached`]), with the same answer bit for bit. Touching
-//! configurations (vertices within the tolerance of a plane, flush faces) have no
-//! topology and keep the plan, whose faces are clipped again each step.
+//! other way (the plan's vertex–plane tests; for a topology, only the tests of its
+//! own vertices against the other planes); until the pair has moved that far, they
+//! cannot change, and only the evaluation is done again ([`overlap_cached`]), with
+//! the same answer bit for bit. Beyond that, a topology is tested again before it is
+//! read afresh. Touching configurations (a vertex of the intersection within the
+//! tolerance of another plane, flush faces) have no topology and keep the plan,
+//! whose faces are clipped again each step.
 //!
 //! For larger meshes (icospheres of hundreds to tens of thousands of facets) only faces
 //! whose bounding spheres meet the box `R` enclosing both bounding spheres take part,
@@ -181,8 +183,8 @@ pub fn overlap_with(
     place_b(b, &rotation, &t, s);
     if maskable(a) && maskable(b) {
         masked::plan_masked(a, b, &t, s);
-        let topology = topology_of_plan(a, b, s);
-        overlap_by_plan(a, b, &t, topology.as_ref(), s)
+        let topology = topology_of_plan(a, b, &t, s);
+        overlap_by_plan(a, b, &t, topology.as_ref().map(|(topology, _)| topology), s)
     } else {
         culled::overlap_culled(a, b, b_in_a, s)
     }
@@ -194,12 +196,13 @@ pub fn overlap_with(
 ///
 /// # Invariant
 /// While the vertices of each shape have moved relative to the other's planes by
-/// less than the slack allows since `rotation`/`translation`, every vertex–plane and
-/// ball–plane test of the bit-mask path comes out as it did there, so the kept plan
-/// *is* the plan of the current pose; where a topology is kept, B's edges have also
-/// moved less than their distance to A's, so it is the topology of the current pose.
-/// [`overlap_cached`] then answers bit for bit what [`overlap`] answers, skipping
-/// only the tests. Shapes beyond the bit-mask path, and plans of more faces than
+/// less than the slack allows since `rotation`/`translation`, every test the kept
+/// decisions rest on comes out as it did there: for a plan, every vertex–plane and
+/// ball–plane test of the bit-mask path, so it *is* the plan of the current pose;
+/// for a topology, its vertices' tests against the other planes (its validity), so
+/// it is the topology of the current pose (an empty one keeps the plan's tests and
+/// the distances of the edges that could meet). [`overlap_cached`] then answers bit
+/// for bit what [`overlap`] answers, skipping only the tests. Shapes beyond the bit-mask path, and plans of more faces than
 /// fit, are not kept.
 ///
 /// The cache of every candidate pair is read each step, most of them apart: what a
@@ -336,7 +339,7 @@ impl OverlapCache {
         a: &ConvexPolyhedron,
         b: &ConvexPolyhedron,
         shapes: (usize, usize),
-        topology: Option<&Topology>,
+        topology: Option<&(Topology, masked::Slack)>,
         rotation: Matrix3<Real>,
         translation: Vector3<Real>,
         s: &mut OverlapScratch,
@@ -348,17 +351,14 @@ impl OverlapCache {
         }
         self.shapes = shapes;
         self.figures = PairFigures::of(a, b);
-        self.rotation = rotation;
-        self.translation = translation;
-        // The pivot, t/2, as a point of B.
-        self.pivot_in_b = rotation.transpose() * (-0.5 * translation);
         let mut slack = plan.slack;
         (self.b_vertices, self.b_planes) = (0, 0);
         self.decisions = match topology {
             _ if plan.separated => Kept::Separated,
-            Some(topology) => {
+            // A topology needs none of the plan's tests, only its own vertices'.
+            Some((topology, valid)) => {
                 (self.b_vertices, self.b_planes) = topology.b_parts_used();
-                slack = slack.min(topology::edge_slack(a, b, s));
+                slack = *valid;
                 Kept::Topology(topology.clone())
             }
             None => {
@@ -372,7 +372,44 @@ impl OverlapCache {
                 }
             }
         };
+        self.moved_to(rotation, translation, slack);
+    }
+
+    /// Keeps the decisions for the pose (`rotation`, `translation`) with `slack`.
+    fn moved_to(
+        &mut self,
+        rotation: Matrix3<Real>,
+        translation: Vector3<Real>,
+        slack: masked::Slack,
+    ) {
+        self.rotation = rotation;
+        self.translation = translation;
+        // The pivot, t/2, as a point of B.
+        self.pivot_in_b = rotation.transpose() * (-0.5 * translation);
         self.slack = slack;
+    }
+
+    /// Where a kept topology's slack has run out: tests it at the pose (`rotation`,
+    /// `t`) of B in A and, if it is still the current one, keeps it from this pose and
+    /// answers by it. Most renewals of a topology find the same one (two pellets in a
+    /// bed rock about their contact), and this test reads none of the plan's.
+    fn revalidate(
+        &mut self,
+        a: &ConvexPolyhedron,
+        b: &ConvexPolyhedron,
+        rotation: &Matrix3<Real>,
+        t: &Vector3<Real>,
+        s: &mut OverlapScratch,
+    ) -> Option<Option<OverlapGeometry>> {
+        let Kept::Topology(topology) = &self.decisions else {
+            return None;
+        };
+        let every_plane = u64::MAX >> (64 - b.face_count());
+        place_b_parts(b, rotation, t, self.b_vertices, every_plane, s);
+        let slack = topology.validate(a, t, self.figures.tolerance, s)?;
+        let answer = topology.evaluate(a, t, s);
+        self.moved_to(*rotation, *t, slack);
+        Some(answer)
     }
 }
 
@@ -425,26 +462,43 @@ pub fn overlap_cached_with(
             }
         };
     }
+    if kept.is_some()
+        && let Some(answer) = cache.revalidate(a, b, &rotation, &t, s)
+    {
+        return answer;
+    }
     place_b(b, &rotation, &t, s);
     masked::plan_masked(a, b, &t, s);
-    let topology = topology_of_plan(a, b, s);
+    let topology = topology_of_plan(a, b, &t, s);
     cache.keep(a, b, shapes, topology.as_ref(), rotation, t, s);
-    overlap_by_plan(a, b, &t, topology.as_ref(), s)
+    let topology = topology.as_ref().map(|(topology, _)| topology);
+    overlap_by_plan(a, b, &t, topology, s)
 }
 
-/// The topology of the intersection by the plan in `s`, where it has one.
+/// The topology of the intersection by the plan in `s`, where it has one, with the
+/// slack within which it stays the current one (all of B in A's frame in `s`; `t` is
+/// B's centroid in A's frame).
 fn topology_of_plan(
     a: &ConvexPolyhedron,
     b: &ConvexPolyhedron,
+    t: &Vector3<Real>,
     s: &mut OverlapScratch,
-) -> Option<Topology> {
+) -> Option<(Topology, masked::Slack)> {
     if s.plan.separated {
         return None;
     }
     let plan = std::mem::take(&mut s.plan);
     let topology = Topology::read(a, b, &plan, s);
     s.plan = plan;
-    topology
+    let topology = topology?;
+    let slack = if topology.is_empty() {
+        // No vertex to test: the intersection stays empty while no vertex crosses a
+        // plane and no edge crosses an edge.
+        s.plan.slack.min(topology::edge_slack(a, b, s))
+    } else {
+        topology.validate(a, t, tolerance(a, b), s)?
+    };
+    Some((topology, slack))
 }
 
 /// The overlap by the plan in `s`: by its topology where it has one (all of B in A's
