@@ -229,3 +229,57 @@ fn a_separation_stands_while_its_plane_separates() {
     assert_eq!(bits(&cached), bits(&overlap(&d, &d, &pose)));
     assert!(cached.is_some());
 }
+
+/// A separating plane tested again at a new pose gives the slack the plan gave it
+/// (to round-off), and no slack once a vertex of the other shape has come within
+/// twice the tolerance: over random separated poses of a dodecahedron and a prism.
+#[test]
+fn a_separating_plane_is_tested_again_as_the_plan_made_it() {
+    use super::{masked, place_b, tolerance};
+    let dodecahedron = generators::dodecahedron(0.005).unwrap();
+    let prism = generators::prism(12, 0.004, 0.006).unwrap();
+    let mut rng = Pcg64::seed_from_u64(23);
+    let mut s = OverlapScratch::default();
+    let mut compared = 0;
+    for (a, b) in [(&dodecahedron, &prism), (&prism, &dodecahedron)] {
+        let tol = tolerance(a, b);
+        for _ in 0..400 {
+            let reach = a.circumradius() + b.circumradius();
+            let t = small_vector(&mut rng, 1.0).normalize() * reach * rng.random_range(0.7..1.0);
+            let rotation = UnitQuaternion::from_scaled_axis(small_vector(&mut rng, 3.0));
+            let rotation = rotation.to_rotation_matrix().into_inner();
+            place_b(b, &rotation, &t, &mut s);
+            masked::plan_masked(a, b, &t, &mut s);
+            if !s.plan.separated {
+                continue;
+            }
+            let planned = s.plan.slack;
+            let again = masked::separation_slack(a, b, &rotation, &t, s.plan.separating, tol);
+            let Some(again) = again else {
+                // Within twice the tolerance of the plane: a margin of order tol.
+                assert!(planned.margin <= tol, "{planned:?}");
+                continue;
+            };
+            let close = |x: Real, y: Real| (x - y).abs() <= 1e-9 * x.abs().max(y.abs());
+            assert!(close(again.margin, planned.margin), "{again:?} {planned:?}");
+            assert!(
+                close(again.per_lever, planned.per_lever),
+                "{again:?} {planned:?}"
+            );
+            compared += 1;
+            // Pushed across the plane by more than its margin: no longer separating.
+            let (of_b, k) = s.plan.separating;
+            let normal = if of_b {
+                rotation * b.planes()[k as usize].normal
+            } else {
+                a.planes()[k as usize].normal
+            };
+            // B's vertices move with B; A's vertices leave a plane of B as B moves
+            // against the normal.
+            let push = if of_b { normal } else { -normal } * 1.5 * planned.margin;
+            let moved = masked::separation_slack(a, b, &rotation, &(t + push), (of_b, k), tol);
+            assert!(moved.is_none());
+        }
+    }
+    assert!(compared > 200, "{compared} separated poses");
+}

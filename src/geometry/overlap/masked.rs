@@ -73,6 +73,9 @@ impl PlannedFace {
 #[derive(Clone, Debug, Default)]
 pub(super) struct FacePlan {
     pub(super) separated: bool,
+    /// Where `separated`: the separating plane the slack is of, a plane of B with
+    /// `true` (A's vertices outside it) or of A.
+    pub(super) separating: (bool, u8),
     /// Faces of A (the first `of_a`), then faces of B.
     pub(super) faces: Vec<PlannedFace>,
     pub(super) of_a: usize,
@@ -218,18 +221,19 @@ fn plan_with_sets<M: VertexSet>(
     if plan.separated {
         // Separated is the one decision that matters: it stands while one separating
         // plane keeps the other shape's vertices outside, whatever the other tests do.
-        let of_b = separating_slack(
+        let (of_b, plane_b) = separating_slack(
             a.vertex_soa(),
             &s.inverse_lever_a,
             &s.b_planes,
             &side_a,
             tol,
         );
-        let of_a = separating_slack(&s.b_point_soa, &s.inverse_lever_b, a.planes(), &side_b, tol);
-        plan.slack = if of_a.margin >= of_b.margin {
-            of_a
+        let (of_a, plane_a) =
+            separating_slack(&s.b_point_soa, &s.inverse_lever_b, a.planes(), &side_b, tol);
+        (plan.slack, plan.separating) = if of_a.margin >= of_b.margin {
+            (of_a, (false, plane_a))
         } else {
-            of_b
+            (of_b, (true, plane_b))
         };
         return;
     }
@@ -439,18 +443,18 @@ fn face_cut<M: VertexSet>(own: &MaskedSide<M>, other: &MaskedSide<M>, f: usize) 
 }
 
 /// The slack of the separating plane of `planes` (those with every vertex of `side`
-/// outside, `points` its vertices) whose tests miss by the most: while that plane
-/// keeps every vertex more than `tol` outside, the shapes stay separated. No plane
-/// separates: no slack (zero margin).
+/// outside, `points` its vertices) whose tests miss by the most, and its index:
+/// while that plane keeps every vertex more than `tol` outside, the shapes stay
+/// separated. No plane separates: no slack (zero margin).
 fn separating_slack<M: VertexSet>(
     points: &PointSoa,
     inverse_lever: &[Real],
     planes: &[Plane],
     side: &MaskedSide<M>,
     tol: Real,
-) -> Slack {
+) -> (Slack, u8) {
     let count = side.shape.vertices().len();
-    let mut best = Slack::SPENT;
+    let (mut best, mut best_plane) = (Slack::SPENT, 0);
     for (k, p) in planes.iter().enumerate() {
         if side.out(k) != side.all {
             continue;
@@ -466,10 +470,47 @@ fn separating_slack<M: VertexSet>(
             })
         });
         if slack.margin > best.margin {
-            best = slack;
+            (best, best_plane) = (slack, k as u8);
         }
     }
-    best
+    (best, best_plane)
+}
+
+/// The slack of plane `plane` separating the shapes at the pose (`rotation`, `t`) of
+/// B in A, a plane of B with `of_b` (A's vertices outside it) or of A: as
+/// [`separating_slack`] makes it, from the plane and the other shape's vertices
+/// alone. `None` where some vertex is not more than `2 tol` outside it.
+pub(super) fn separation_slack(
+    a: &ConvexPolyhedron,
+    b: &ConvexPolyhedron,
+    rotation: &nalgebra::Matrix3<Real>,
+    t: &Vector3<Real>,
+    (of_b, plane): (bool, u8),
+    tol: Real,
+) -> Option<Slack> {
+    let pivot = Point3::from(0.5 * t);
+    let outside = |plane: &Plane, p: Point3<Real>| {
+        let miss = plane.distance(&p) - tol;
+        // More than twice the tolerance outside: the fresh plan's masks, whose
+        // distances round otherwise, find every vertex outside too.
+        (miss > tol).then(|| Slack {
+            margin: miss,
+            per_lever: miss / (p - pivot).norm().max(Real::MIN_POSITIVE),
+        })
+    };
+    let mut slack = Slack::NONE;
+    if of_b {
+        let plane = super::plane_in_a(&b.planes()[plane as usize], rotation, t);
+        for p in a.vertices() {
+            slack = slack.min(outside(&plane, *p)?);
+        }
+    } else {
+        let plane = &a.planes()[plane as usize];
+        for p in b.vertices() {
+            slack = slack.min(outside(plane, Point3::from(rotation * p.coords + t))?);
+        }
+    }
+    Some(slack)
 }
 
 /// Planes (bits) whose outside the ball (`centre`, `radius`) reaches to within `tol`,

@@ -240,8 +240,9 @@ const _: () = assert!(OverlapCache::HOT_BYTES <= 3 * 64);
 #[derive(Clone, Debug)]
 #[repr(u8)]
 enum Kept {
-    /// A face plane separates the shapes.
-    Separated,
+    /// A face plane separates the shapes: a plane of B with `plane.0` (A's vertices
+    /// outside it) or of A, by index.
+    Separated { plane: (bool, u8) },
     /// The intersection's topology: while it holds (the slack then also covers
     /// edge–edge crossings) it is evaluated instead of clipping.
     Topology(Topology),
@@ -269,7 +270,7 @@ impl Default for OverlapCache {
             figures: PairFigures::default(),
             b_vertices: 0,
             b_planes: 0,
-            decisions: Kept::Separated,
+            decisions: Kept::Separated { plane: (false, 0) },
         }
     }
 }
@@ -302,7 +303,7 @@ impl OverlapCache {
     /// a pair kept apart reads only [`Self::HOT_BYTES`].
     #[inline]
     pub fn keeps_contact(&self) -> bool {
-        self.slack.is_kept() && !matches!(self.decisions, Kept::Separated)
+        self.slack.is_kept() && !matches!(self.decisions, Kept::Separated { .. })
     }
 
     /// The figures of the pair, where decisions are kept for these `shapes`.
@@ -354,7 +355,9 @@ impl OverlapCache {
         let mut slack = plan.slack;
         (self.b_vertices, self.b_planes) = (0, 0);
         self.decisions = match topology {
-            _ if plan.separated => Kept::Separated,
+            _ if plan.separated => Kept::Separated {
+                plane: plan.separating,
+            },
             // A topology needs none of the plan's tests, only its own vertices'.
             Some((topology, valid)) => {
                 (self.b_vertices, self.b_planes) = topology.b_parts_used();
@@ -389,10 +392,12 @@ impl OverlapCache {
         self.slack = slack;
     }
 
-    /// Where a kept topology's slack has run out: tests it at the pose (`rotation`,
-    /// `t`) of B in A and, if it is still the current one, keeps it from this pose and
-    /// answers by it. Most renewals of a topology find the same one (two pellets in a
-    /// bed rock about their contact), and this test reads none of the plan's.
+    /// Where the slack of a kept topology or separation has run out: tests it at the
+    /// pose (`rotation`, `t`) of B in A and, if it still holds, keeps it from this
+    /// pose and answers by it. Most renewals of a topology find the same one (two
+    /// pellets in a bed rock about their contact), and this test reads none of the
+    /// plan's; a separating plane is tested against the other shape's vertices
+    /// alone, and a fresh overlap then finds the pair apart too.
     fn revalidate(
         &mut self,
         a: &ConvexPolyhedron,
@@ -401,8 +406,15 @@ impl OverlapCache {
         t: &Vector3<Real>,
         s: &mut OverlapScratch,
     ) -> Option<Option<OverlapGeometry>> {
-        let Kept::Topology(topology) = &self.decisions else {
-            return None;
+        let topology = match &self.decisions {
+            Kept::Topology(topology) => topology,
+            Kept::Separated { plane } => {
+                let tol = self.figures.tolerance;
+                let slack = masked::separation_slack(a, b, rotation, t, *plane, tol)?;
+                self.moved_to(*rotation, *t, slack);
+                return Some(None);
+            }
+            Kept::Plan { .. } => return None,
         };
         let every_plane = u64::MAX >> (64 - b.face_count());
         place_b_parts(b, rotation, t, self.b_vertices, every_plane, s);
@@ -449,12 +461,12 @@ pub fn overlap_cached_with(
     let rotation = b_in_a.rotation.to_rotation_matrix().into_inner();
     if kept.is_some() && cache.holds(&rotation, &t) {
         // A kept separation needs not even B's vertices.
-        if let Kept::Separated = cache.decisions {
+        if let Kept::Separated { .. } = cache.decisions {
             return None;
         }
         place_b_parts(b, &rotation, &t, cache.b_vertices, cache.b_planes, s);
         return match &cache.decisions {
-            Kept::Separated => None,
+            Kept::Separated { .. } => None,
             Kept::Topology(topology) => topology.evaluate(a, &t, s),
             Kept::Plan { faces, of_a, len } => {
                 let (of_a, len) = (*of_a as usize, *len as usize);
