@@ -283,3 +283,32 @@ fn a_separating_plane_is_tested_again_as_the_plan_made_it() {
     }
     assert!(compared > 200, "{compared} separated poses");
 }
+
+/// Kept and fresh answers agree bit for bit between unlike shapes too: every pair of
+/// six (with the cube's and the hexagonal prism's parallel faces, and random hulls of
+/// small faces at all angles), from deep to shallow, slow and fast.
+#[test]
+fn unlike_shapes_answer_bit_for_bit() {
+    let shapes = [
+        generators::dodecahedron(0.005).unwrap(),
+        generators::prism(20, 5.5e-3, 5.5e-3).unwrap(),
+        generators::cuboid(0.008, 0.008, 0.008).unwrap(),
+        generators::random_convex(14, 0.005, 0.3, 2).unwrap(),
+        generators::random_convex(30, 0.005, 0.3, 9).unwrap(),
+        generators::prism(6, 4e-3, 8e-3).unwrap(),
+    ];
+    let mut total = [0; 5];
+    for (i, a) in shapes.iter().enumerate() {
+        for (j, b) in shapes.iter().enumerate() {
+            let seed = (6 * i + j) as u64;
+            for (start, step, turn) in [(0.6, 1e-7, 1e-5), (0.75, 1e-5, 1e-3)] {
+                let counts = walk_from(a, b, start, seed, step, turn);
+                total = std::array::from_fn(|k| total[k] + counts[k]);
+            }
+        }
+    }
+    let [_, renewed, overlapping, by_topology, same] = total;
+    assert!(overlapping > 80_000, "{total:?}");
+    assert!(by_topology > overlapping / 2, "{total:?}");
+    assert!(same > renewed / 5, "{total:?}");
+}
