@@ -507,7 +507,7 @@ pub(super) fn separation_slack(
     } else {
         let plane = &a.planes()[plane as usize];
         for p in b.vertices() {
-            slack = slack.min(outside(plane, Point3::from(rotation * p.coords + t))?);
+            slack = slack.min(outside(plane, super::point_in_a(p, rotation, t))?);
         }
     }
     Some(slack)

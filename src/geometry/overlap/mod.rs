@@ -202,8 +202,8 @@ pub fn overlap_with(
 /// for a topology, its vertices' tests against the other planes (its validity), so
 /// it is the topology of the current pose (an empty one keeps the plan's tests and
 /// the distances of the edges that could meet). [`overlap_cached`] then answers bit
-/// for bit what [`overlap`] answers, skipping only the tests. Shapes beyond the bit-mask path, and plans of more faces than
-/// fit, are not kept.
+/// for bit what [`overlap`] answers, skipping only the tests. Shapes beyond the
+/// bit-mask path, and plans of more faces than fit, are not kept.
 ///
 /// The cache of every candidate pair is read each step, most of them apart: what a
 /// pair apart reads (the fields up to `decisions`' tag, 176 bytes) comes first and
@@ -243,8 +243,9 @@ enum Kept {
     /// A face plane separates the shapes: a plane of B with `plane.0` (A's vertices
     /// outside it) or of A, by index.
     Separated { plane: (bool, u8) },
-    /// The intersection's topology: while it holds (the slack then also covers
-    /// edge–edge crossings) it is evaluated instead of clipping.
+    /// The intersection's topology: while it holds (the slack is that of its
+    /// vertices' tests, see [`Topology::validate`]) it is evaluated instead of
+    /// clipping.
     Topology(Topology),
     /// The faces of A (the first `of_a`), then of B, to clip, and the planes to clip
     /// each by: for touching configurations, which have no topology.
@@ -544,15 +545,20 @@ fn maskable(p: &ConvexPolyhedron) -> bool {
 /// centroid `t` in A), and clears the piece vertices.
 fn place_b(b: &ConvexPolyhedron, rot: &Matrix3<Real>, t: &Vector3<Real>, s: &mut OverlapScratch) {
     s.b_points.clear();
-    s.b_points.extend(
-        b.vertices()
-            .iter()
-            .map(|p| Point3::from(rot * p.coords + t)),
-    );
+    s.b_points
+        .extend(b.vertices().iter().map(|p| point_in_a(p, rot, t)));
     s.b_planes.clear();
     s.b_planes
         .extend(b.planes().iter().map(|p| plane_in_a(p, rot, t)));
     s.points.clear();
+}
+
+/// A point of B in A's frame (B's rotation `rot` and centroid `t` in A): one
+/// formula wherever B is placed, so that a part placed alone has the bits of B
+/// placed whole.
+#[inline]
+fn point_in_a(p: &Point3<Real>, rot: &Matrix3<Real>, t: &Vector3<Real>) -> Point3<Real> {
+    Point3::from(rot * p.coords + t)
 }
 
 /// A plane of B in A's frame (B's rotation `rot` and centroid `t` in A).
@@ -579,7 +585,7 @@ fn place_b_parts(
     while vertices != 0 {
         let v = vertices.trailing_zeros() as usize;
         vertices &= vertices - 1;
-        s.b_points[v] = Point3::from(rot * b.vertices()[v].coords + t);
+        s.b_points[v] = point_in_a(&b.vertices()[v], rot, t);
     }
     s.b_planes.resize(
         b.face_count(),

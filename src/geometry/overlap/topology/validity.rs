@@ -27,9 +27,9 @@ use nalgebra::{Point3, Vector3};
 
 use super::super::OverlapScratch;
 use super::super::masked::Slack;
-use super::{Kind, Topology, edge_cut};
+use super::{Kind, Topology};
 use crate::Real;
-use crate::geometry::{ConvexPolyhedron, Plane};
+use crate::geometry::{ConvexPolyhedron, Plane, polygon};
 
 impl Topology {
     /// The slack within which the topology stays the current one, or `None` where at
@@ -72,7 +72,7 @@ impl Topology {
                     let ends = [&s.b_points[i], &s.b_points[o]];
                     cut_slack(ends, ends.map(lever), planes_a, plane, tol)?
                 }
-                Kind::Unlabelled => return None,
+                Kind::Unlabelled => unreachable!("a kept topology has every vertex labelled"),
             };
             slack = slack.min(entry);
         }
@@ -102,7 +102,8 @@ fn cut_slack(
     let [u, v] = ends;
     let (du, dv) = (planes[cut].distance(u), planes[cut].distance(v));
     let ends = miss_slack(-du - tol, levers[0])?.min(miss_slack(dv - tol, levers[1])?);
-    let x = edge_cut(u, v, &planes[cut]);
+    // The point `edge_cut` gives, from the distances at hand.
+    let x = polygon::cut(u, du, v, dv);
     let (edge, slope) = (v - u, dv - du);
     let mut margin = Real::INFINITY;
     for (k, h) in planes.iter().enumerate() {
