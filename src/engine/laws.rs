@@ -171,8 +171,14 @@ impl ContactLaws {
     ///
     /// The volume law's damping tables are calibrated only when a contact can follow
     /// that law: not in a scene of spheres under Hertz–Mindlin (a calibration costs a
-    /// few tenths of a second).
-    pub(super) fn prepare(&mut self, world: &World, regularisation_length: Real, round: RoundLaw) {
+    /// few tenths of a second). Returns whether the rows were made anew (as they are
+    /// whenever a body type's shape, by address, or a sphere's radius changes).
+    pub(super) fn prepare(
+        &mut self,
+        world: &World,
+        regularisation_length: Real,
+        round: RoundLaw,
+    ) -> bool {
         let materials = &world.materials;
         let volume_law = round == RoundLaw::Volume
             || world
@@ -180,7 +186,7 @@ impl ContactLaws {
                 .iter()
                 .any(|t| t.shape.as_sphere().is_none());
         if self.made_from.are(world, regularisation_length, volume_law) {
-            return;
+            return false;
         }
         self.made_from = Inputs {
             materials: materials.clone(),
@@ -234,6 +240,7 @@ impl ContactLaws {
                 }),
             }
         }));
+        true
     }
 
     fn table_index(&mut self, e: Real) -> usize {
@@ -377,14 +384,18 @@ mod tests {
         let body = BodyType::new(cube, &world.materials[0], 0);
         world.body_types.push(body);
         let mut laws = ContactLaws::default();
+        // The rows of type 0, where they were made anew (the type table of the CPU
+        // backend is made anew with them).
         let prepare = |laws: &mut ContactLaws, world: &World, l: Real| {
-            laws.prepare(world, l, RoundLaw::Volume);
+            let made = laws.prepare(world, l, RoundLaw::Volume);
+            assert!(made, "the rows were not made anew");
             laws.pair(0, 0)
         };
         let first = prepare(&mut laws, &world, 0.05);
         assert_eq!(first.friction, 0.3);
         // The same world: the same rows.
-        let again = prepare(&mut laws, &world, 0.05);
+        assert!(!laws.prepare(&world, 0.05, RoundLaw::Volume));
+        let again = laws.pair(0, 0);
         assert_eq!(again.stiffness, first.stiffness);
         assert_eq!(again.friction, first.friction);
         // A material changed in place.

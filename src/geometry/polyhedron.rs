@@ -26,14 +26,19 @@ const HILL_CLIMB_THRESHOLD: usize = 48;
 ///   outward unit normal; coplanar input triangles are merged into one face;
 /// - every vertex lies on or behind every face plane (to round-off);
 /// - the inertia tensor is diagonal in this frame (`principal_inertia`).
+///
+/// The fields a kept contact reads of the template itself come first, in one cache
+/// line (hence `repr(C)`; see [`Self::contact_memory`]).
 #[derive(Clone, Debug)]
+#[repr(C)]
 pub struct ConvexPolyhedron {
     vertices: Vec<Point3<Real>>,
+    planes: Vec<Plane>,
+    circumradius: Real,
     /// Vertex indices of all face loops, concatenated.
     face_loops: Vec<u32>,
     /// `face_loops[face_starts[f]..face_starts[f + 1]]` is face `f`.
     face_starts: Vec<u32>,
-    planes: Vec<Plane>,
     /// The same planes in structure-of-arrays form (for the overlap kernel).
     plane_soa: PlaneSoa,
     /// The vertices in structure-of-arrays form (for the overlap kernel).
@@ -51,10 +56,14 @@ pub struct ConvexPolyhedron {
     /// Radius of the sphere of equal volume (kept: contact laws read it per pair).
     equivalent_radius: Real,
     principal_inertia: Vector3<Real>,
-    circumradius: Real,
     /// Maps body coordinates to the coordinates of the mesh it was built from.
     body_to_input: Isometry3<Real>,
 }
+
+/// What a kept contact reads of the template itself: its vertices, its planes and its
+/// circumradius (the coplanarity tolerance), in the first cache line.
+const CONTACT_HEADER: usize = std::mem::offset_of!(ConvexPolyhedron, circumradius) + 8;
+const _: () = assert!(CONTACT_HEADER <= 64);
 
 impl ConvexPolyhedron {
     /// Builds a template from a closed, convex triangle mesh given in any frame.
@@ -298,6 +307,22 @@ impl ConvexPolyhedron {
             }
         }
         out
+    }
+
+    /// Where in memory lies what the overlap of a kept contact reads of this
+    /// template: the fields of the template it reads, its vertices and its planes, as
+    /// address ranges (for software prefetch, which reads nothing: nothing may be
+    /// read through them).
+    pub fn contact_memory(&self) -> [std::ops::Range<usize>; 3] {
+        let range = |start: usize, bytes: usize| start..start + bytes;
+        [
+            range(std::ptr::from_ref(self).addr(), CONTACT_HEADER),
+            range(
+                self.vertices.as_ptr().addr(),
+                size_of_val(&self.vertices[..]),
+            ),
+            range(self.planes.as_ptr().addr(), size_of_val(&self.planes[..])),
+        ]
     }
 
     /// Index of a vertex farthest along `dir` (body frame). `hint` is a vertex to

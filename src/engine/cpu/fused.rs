@@ -19,7 +19,8 @@
 use super::contact_state::ContactState;
 use super::pair_results::BLOCK;
 use super::pairs::{BlockPlans, ContactTotals, PairLaws, StartLoads, evaluate_block};
-use super::prefetch::PlanPrefetch;
+use super::prefetch::PairPrefetch;
+use super::type_table::TypeTable;
 use crate::Real;
 use crate::engine::neighbours::NeighbourList;
 use crate::geometry::overlap::OverlapCache;
@@ -32,7 +33,7 @@ pub(super) fn pair_contacts_gathered(
     world: &mut World,
     list: &NeighbourList,
     state: &mut ContactState,
-    radii: &[Real],
+    (radii, types): (&[Real], &TypeTable),
     laws: PairLaws,
     touching: &mut Vec<bool>,
 ) -> ContactTotals {
@@ -54,8 +55,8 @@ pub(super) fn pair_contacts_gathered(
     }
     let with_plans = state.overlap_plans.len() == list.pairs().len();
     let mut spare = OverlapCache::default();
-    let prefetch = PlanPrefetch::of(&state.overlap_plans);
     let pairs = list.pairs();
+    let prefetch = PairPrefetch::new(&state.overlap_plans, pairs, &p.body_type, types);
     let mut totals = ContactTotals::of_candidates(p, pairs);
     for first in (0..pairs.len()).step_by(BLOCK) {
         let block = first..pairs.len().min(first + BLOCK);

@@ -29,12 +29,14 @@ mod pairs;
 mod patch;
 mod prefetch;
 mod relative_motion;
+mod type_table;
 mod walls;
 
 use std::ops::Range;
 
 use self::contact_state::ContactState;
 use self::pair_results::PairResults;
+use self::type_table::TypeTable;
 use self::walls::{WallInputs, WallWork};
 use super::backend::{Backend, ContactHistory};
 use super::laws::ContactLaws;
@@ -60,13 +62,14 @@ struct Workspace {
 }
 
 /// The CPU engine: step parameters, persistent contact state, the neighbour list, the
-/// contact-law table, scratch buffers and statistics.
+/// contact-law and body-type tables, scratch buffers and statistics.
 #[derive(Clone, Debug, Default)]
 pub struct CpuBackend {
     params: StepParams,
     list: NeighbourList,
     contacts: ContactState,
     laws: ContactLaws,
+    types: TypeTable,
     work: Workspace,
     stats: StepStats,
     times: StageTimes,
@@ -118,15 +121,18 @@ impl CpuBackend {
             list,
             contacts,
             laws,
+            types,
             work,
             stats,
             times,
         } = self;
         times.time(Stage::Laws, || {
-            laws.prepare(world, params.regularisation_length, params.round_law)
+            if laws.prepare(world, params.regularisation_length, params.round_law) {
+                types.make(world);
+            }
         });
         times.time(Stage::NeighbourList, || {
-            update_list(list, contacts, world, &mut work.radii)
+            update_list(list, contacts, world, types, &mut work.radii)
         });
         let pair_laws = pairs::PairLaws {
             laws,
@@ -139,7 +145,7 @@ impl CpuBackend {
                     world,
                     list,
                     contacts,
-                    &work.radii,
+                    (&work.radii, types),
                     pair_laws,
                     &mut work.touching,
                 )
@@ -150,7 +156,7 @@ impl CpuBackend {
                     world,
                     list,
                     contacts,
-                    &work.radii,
+                    (&work.radii, types),
                     pair_laws,
                     &mut work.results,
                 )
@@ -164,6 +170,7 @@ impl CpuBackend {
             let inputs = WallInputs {
                 list,
                 laws,
+                types,
                 round: params.round_law,
                 dt,
             };
@@ -194,17 +201,11 @@ fn update_list(
     list: &mut NeighbourList,
     contacts: &mut ContactState,
     world: &World,
+    types: &TypeTable,
     radii: &mut Vec<Real>,
 ) {
-    let types = &world.body_types;
     radii.clear();
-    radii.extend(
-        world
-            .particles
-            .body_type
-            .iter()
-            .map(|&k| types[k as usize].shape.circumradius()),
-    );
+    radii.extend(world.particles.body_type.iter().map(|&t| types.radius(t)));
     if list.is_stale(world) {
         contacts.rebuild(list, world, radii);
     }

@@ -9,7 +9,8 @@ use super::dispatch::pair_geometry;
 use super::forces::{ContactForce, PairResult, RelativeMotion, pair_force};
 use super::hertz::{HertzInputs, rolling_inertia, round_contact_force, round_radius, sphere_pair};
 use super::pair_results::{BLOCK, BusyBits, PairResults};
-use super::prefetch::PlanPrefetch;
+use super::prefetch::PairPrefetch;
+use super::type_table::TypeTable;
 use crate::Real;
 use crate::contact::{RollingModel, TangentialHistory, effective_radius};
 use crate::engine::RoundLaw;
@@ -136,12 +137,13 @@ pub(super) fn evaluate_pair(
 }
 
 /// Evaluates the candidate pairs into `results`, in parallel over blocks of pairs
-/// ([`evaluate_block`]).
+/// ([`evaluate_block`]); `radii` are the particles' bounding radii, `types` the
+/// table of their body types.
 pub(super) fn pair_contacts(
     world: &World,
     list: &NeighbourList,
     state: &mut ContactState,
-    radii: &[Real],
+    (radii, types): (&[Real], &TypeTable),
     laws: PairLaws,
     results: &mut PairResults,
 ) {
@@ -149,7 +151,7 @@ pub(super) fn pair_contacts(
     let block = |b: usize,
                  (results, mask): (&mut [PairResult], &mut u64),
                  history: &mut [TangentialHistory],
-                 plans: Option<(&mut [OverlapCache], PlanPrefetch)>,
+                 plans: Option<(&mut [OverlapCache], PairPrefetch)>,
                  spare: &mut OverlapCache| {
         let first = b * BLOCK;
         let pairs = &pairs[first..first + results.len()];
@@ -175,7 +177,8 @@ pub(super) fn pair_contacts(
         .zip(state.pair_history.par_chunks_mut(BLOCK))
         .enumerate();
     if state.overlap_plans.len() == pairs.len() {
-        let prefetch = PlanPrefetch::of(&state.overlap_plans);
+        let p = &world.particles;
+        let prefetch = PairPrefetch::new(&state.overlap_plans, pairs, &p.body_type, types);
         blocks
             .zip(state.overlap_plans.par_chunks_mut(BLOCK))
             .for_each_init(
@@ -195,7 +198,7 @@ pub(super) fn pair_contacts(
 /// The overlap plans of a block of pairs starting at pair `first` of the list.
 pub(super) struct BlockPlans<'a> {
     pub plans: &'a mut [OverlapCache],
-    pub prefetch: PlanPrefetch,
+    pub prefetch: PairPrefetch<'a>,
     pub first: usize,
 }
 

@@ -1,4 +1,5 @@
-//! Software prefetch of the pair stage's kept overlap plans.
+//! Software prefetch of the pair stage: the kept overlap plans, and the shapes of
+//! the contacts they keep.
 //!
 //! The pairs are swept in list order, but only those whose bounding spheres overlap
 //! read their plan, so the plans are read at an irregular stride that the hardware
@@ -8,69 +9,134 @@
 //!
 //! In two stages: the first lines of a plan (what a pair apart reads) [`AHEAD`] pairs
 //! ahead; then, [`REST_AHEAD`] pairs ahead, where those lines say that the plan keeps
-//! a contact's decisions, the rest of it (the topology a contact evaluates). In the
-//! dense dodecahedron bed (`talus bench` (a)) the loads of the topology's labels and
-//! loops were a third of its evaluation's samples, and the second stage made a step
-//! 3–9 % faster on one thread.
+//! a contact's decisions, the rest of it (the topology a contact evaluates) and what
+//! the contact reads of its two shapes (the templates, their vertices and planes,
+//! found through the [`TypeTable`] without reading the shapes). In the dense
+//! dodecahedron bed (`talus bench` (a)) the loads of the topology's labels and loops
+//! were a third of its evaluation's samples, and fetching the rest of the plan made
+//! a step 3–9 % faster on one thread. Where every particle has a shape of its own
+//! (scene (d)), a contact's reads of the shapes waited on memory link by link
+//! (template, then its vertices and planes): placing B's points took a tenth of the
+//! step.
 
+use std::ops::Range;
+
+use super::type_table::TypeTable;
 use crate::geometry::overlap::OverlapCache;
 
 /// How many pairs ahead the plans are fetched: enough to cover a memory access at
 /// the rate pairs apart are swept (a few tens of nanoseconds each).
 const AHEAD: usize = 6;
 
-/// How many pairs ahead a contact's plan is fetched whole: its first lines, asked
-/// for `AHEAD − REST_AHEAD` pairs before, have then arrived.
+/// How many pairs ahead a contact's plan is fetched whole, with its shapes: its
+/// first lines, asked for `AHEAD − REST_AHEAD` pairs before, have then arrived.
 const REST_AHEAD: usize = 3;
 
-/// Where the plans lie, to prefetch from while they are borrowed elsewhere (an
-/// address only: nothing is read through it).
+/// Where the plans lie, and how to find a pair's shapes, to prefetch from while the
+/// plans are borrowed elsewhere (the plans by address only: nothing is read through
+/// it).
 #[derive(Clone, Copy, Debug)]
-pub(super) struct PlanPrefetch {
+pub(super) struct PairPrefetch<'a> {
     start: usize,
     len: usize,
+    /// The list's pairs, the particles' body types and the types' table.
+    pairs: &'a [[u32; 2]],
+    body_type: &'a [u32],
+    types: &'a TypeTable,
 }
 
-impl PlanPrefetch {
-    pub(super) fn of(plans: &[OverlapCache]) -> Self {
-        PlanPrefetch {
+impl<'a> PairPrefetch<'a> {
+    /// Prefetches for the `plans` of the list's `pairs`, of particles of `body_type`.
+    pub(super) fn new(
+        plans: &[OverlapCache],
+        pairs: &'a [[u32; 2]],
+        body_type: &'a [u32],
+        types: &'a TypeTable,
+    ) -> Self {
+        PairPrefetch {
             start: plans.as_ptr().addr(),
             len: plans.len(),
+            pairs,
+            body_type,
+            types,
         }
     }
 
-    /// Starts fetching what pairs a few ahead of pair `k` of a block will read of
-    /// their plans: the first lines of pair `k + AHEAD` (that of the list, if there
-    /// is one), and the rest of pair `k + REST_AHEAD`'s if it keeps a contact (in
-    /// the block: `plans` are the block's, the first of them pair `first` of the
-    /// list).
+    /// Starts fetching what pairs a few ahead of pair `k` of a block will read: the
+    /// first lines of pair `k + AHEAD`'s plan (that of the list, if there is one),
+    /// and, if pair `k + REST_AHEAD` keeps a contact, the rest of its plan and what
+    /// its contact reads of its shapes (in the block: `plans` are the block's, the
+    /// first of them pair `first` of the list).
     #[inline(always)]
     pub(super) fn ahead(self, plans: &[OverlapCache], first: usize, k: usize) {
-        self.fetch(first + k + AHEAD, 0..OverlapCache::HOT_BYTES);
-        if plans
-            .get(k + REST_AHEAD)
-            .is_some_and(OverlapCache::keeps_contact)
-        {
+        if first + k + AHEAD < self.len {
+            self.fetch_plan(first + k + AHEAD, 0..OverlapCache::HOT_BYTES);
+        }
+        let keeps = |k: usize| plans.get(k).is_some_and(OverlapCache::keeps_contact);
+        if keeps(k + REST_AHEAD) {
+            let pair = first + k + REST_AHEAD;
             let hot = OverlapCache::HOT_BYTES.next_multiple_of(64);
-            self.fetch(first + k + REST_AHEAD, hot..size_of::<OverlapCache>());
+            self.fetch_plan(pair, hot..size_of::<OverlapCache>());
+            if !self.types.fetch_shapes() {
+                return;
+            }
+            // The pairs are sorted by their first particle: where the pair before
+            // kept a contact with the same first particle, its shape is on its way.
+            let [i, j] = self.pairs[pair];
+            if !(keeps(k + REST_AHEAD - 1) && self.pairs[pair - 1][0] == i) {
+                self.fetch_shape(i);
+            }
+            self.fetch_shape(j);
         }
     }
 
-    /// Starts fetching the cache lines that hold `bytes` of plan `k`, if there is
-    /// such a plan.
+    /// Starts fetching the cache lines that hold `bytes` of plan `k` (a plan starts a
+    /// line; the bytes are constants, so the lines are a few prefetches in a row).
     #[inline(always)]
-    fn fetch(self, k: usize, bytes: std::ops::Range<usize>) {
-        #[cfg(target_arch = "x86_64")]
-        if k < self.len {
-            use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
-            let at = self.start + k * size_of::<OverlapCache>();
-            for line in bytes.step_by(64) {
-                // SAFETY: SSE is part of x86_64; a prefetch reads nothing and cannot
-                // fault.
-                unsafe { _mm_prefetch::<_MM_HINT_T0>(std::ptr::without_provenance(at + line)) };
-            }
+    fn fetch_plan(self, k: usize, bytes: Range<usize>) {
+        let at = self.start + k * size_of::<OverlapCache>();
+        for line in bytes.step_by(64) {
+            fetch_line(at + line);
         }
-        #[cfg(not(target_arch = "x86_64"))]
-        let _ = (k, bytes);
     }
+
+    /// Starts fetching what a kept contact reads of particle `k`'s shape.
+    #[inline(always)]
+    fn fetch_shape(self, k: u32) {
+        fetch_shape(self.types, self.body_type[k as usize]);
+    }
+}
+
+/// Starts fetching what a contact reads of body type `t`'s shape (a kept contact
+/// between particles, or a particle's contact with a wall facet: the template's
+/// first line, its vertices and planes).
+#[inline(always)]
+pub(super) fn fetch_shape(types: &TypeTable, t: u32) {
+    if !types.fetch_shapes() {
+        return;
+    }
+    for range in types.contact_memory(t) {
+        fetch(range.clone());
+    }
+}
+
+/// Starts fetching the cache lines that hold the addresses `bytes`.
+#[inline(always)]
+fn fetch(bytes: Range<usize>) {
+    for line in (bytes.start & !63..bytes.end).step_by(64) {
+        fetch_line(line);
+    }
+}
+
+/// Starts fetching the cache line that holds the address `at`.
+#[inline(always)]
+fn fetch_line(at: usize) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
+        // SAFETY: SSE is part of x86_64; a prefetch reads nothing and cannot fault.
+        unsafe { _mm_prefetch::<_MM_HINT_T0>(std::ptr::without_provenance(at)) };
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = at;
 }

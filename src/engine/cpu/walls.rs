@@ -15,6 +15,8 @@ use super::forces::{ContactForce, LawInputs, RelativeMotion, contact_force};
 use super::hertz::{HertzInputs, rolling_inertia, round_contact_force};
 use super::pairs::ContactTotals;
 use super::patch::{Merge, PatchSet, plane_key};
+use super::prefetch::fetch_shape;
+use super::type_table::TypeTable;
 use crate::Real;
 use crate::contact::TangentialHistory;
 use crate::engine::RoundLaw;
@@ -30,6 +32,12 @@ use crate::world::{Wall, World};
 /// enough for two threads to share the floor; a particle's wall contacts can cost as
 /// much as a hundred kick–drifts (a pellet against the facets of a tube).
 const PARTICLES_PER_CHUNK: usize = 64;
+
+/// How many particles ahead the shape of a particle near a wall is fetched: where
+/// each particle has a shape of its own, the first read of each shape went to
+/// memory (scene (d) of `talus bench`: the support query's scan of the vertices, 2 %
+/// of a step), and a particle's facet contacts take long enough to cover a fetch.
+const SHAPE_AHEAD: usize = 2;
 
 /// One particle–wall contact: a coplanar patch of one wall's facets.
 #[derive(Clone, Debug)]
@@ -55,6 +63,7 @@ pub(super) struct WallChunk {
 pub(super) struct WallInputs<'a> {
     pub list: &'a NeighbourList,
     pub laws: &'a ContactLaws,
+    pub types: &'a TypeTable,
     /// The law of a sphere's contacts.
     pub round: RoundLaw,
     pub dt: Real,
@@ -141,6 +150,10 @@ pub(super) fn wall_contacts(
             chunk.shares.clear();
             let start = c * PARTICLES_PER_CHUNK;
             for i in start..(start + PARTICLES_PER_CHUNK).min(n) {
+                let ahead = i + SHAPE_AHEAD;
+                if inputs.types.fetch_shapes() && ahead < n && near_walls(w, &inputs, ahead) {
+                    fetch_shape(inputs.types, w.particles.body_type[ahead]);
+                }
                 if !w.particles.is_passive(i) {
                     particle_contacts(w, i, &inputs, placed, kept, chunk);
                 }
@@ -188,6 +201,12 @@ pub(super) fn wall_contacts(
 
 /// Contacts of particle `i` with every wall, one per coplanar patch of facets, pushed
 /// onto `chunk`.
+/// Whether particle `i` has facets of some wall in its list.
+#[inline]
+fn near_walls(world: &World, inputs: &WallInputs, i: usize) -> bool {
+    (0..world.walls.len()).any(|w| !inputs.list.facets(i, w).is_empty())
+}
+
 fn particle_contacts(
     world: &World,
     i: usize,
@@ -199,16 +218,17 @@ fn particle_contacts(
     let WallInputs {
         list,
         laws,
+        types,
         round,
         dt,
     } = *inputs;
     // Most particles of a bed are far from every wall: leave before anything else.
-    if (0..world.walls.len()).all(|w| list.facets(i, w).is_empty()) {
+    if !near_walls(world, inputs, i) {
         return;
     }
     let p = &world.particles;
     let t = &world.body_types[p.body_type[i] as usize];
-    let radius = t.shape.circumradius();
+    let radius = types.radius(p.body_type[i]);
     let pose = pose_of(world, i);
     let merge = match t.shape {
         Shape::Polyhedron(_) => Merge::Sum,
