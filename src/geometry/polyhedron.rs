@@ -62,7 +62,8 @@ pub struct ConvexPolyhedron {
 
 /// What a kept contact reads of the template itself: its vertices, its planes and its
 /// circumradius (the coplanarity tolerance), in the first cache line.
-const CONTACT_HEADER: usize = std::mem::offset_of!(ConvexPolyhedron, circumradius) + 8;
+const CONTACT_HEADER: usize =
+    std::mem::offset_of!(ConvexPolyhedron, circumradius) + size_of::<Real>();
 const _: () = assert!(CONTACT_HEADER <= 64);
 
 impl ConvexPolyhedron {

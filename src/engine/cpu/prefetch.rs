@@ -109,12 +109,10 @@ impl<'a> PairPrefetch<'a> {
 
 /// Starts fetching what a contact reads of body type `t`'s shape (a kept contact
 /// between particles, or a particle's contact with a wall facet: the template's
-/// first line, its vertices and planes).
+/// first line, its vertices and planes). The callers ask only where
+/// [`TypeTable::fetch_shapes`] says it is worth it, before finding `t`.
 #[inline(always)]
 pub(super) fn fetch_shape(types: &TypeTable, t: u32) {
-    if !types.fetch_shapes() {
-        return;
-    }
     for range in types.contact_memory(t) {
         fetch(range.clone());
     }

@@ -53,18 +53,14 @@ impl TypeTable {
                 Shape::Sphere(_) => [0..0, 0..0, 0..0],
             },
         }));
+        // Each distinct template once, known by where it lies (a sphere's empty
+        // ranges add nothing).
         let mut seen = HashSet::new();
-        let bytes: usize = world
-            .body_types
+        let bytes: usize = self
+            .rows
             .iter()
-            .filter_map(|t| t.shape.as_polyhedron())
-            .filter(|&p| seen.insert(std::ptr::from_ref(p)))
-            .map(|p| {
-                p.contact_memory()
-                    .iter()
-                    .map(ExactSizeIterator::len)
-                    .sum::<usize>()
-            })
+            .filter(|r| seen.insert(r.contact_memory[0].start))
+            .flat_map(|r| r.contact_memory.iter().map(ExactSizeIterator::len))
             .sum();
         self.fetch_shapes = bytes > CACHED_SHAPE_BYTES;
     }

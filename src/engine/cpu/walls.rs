@@ -199,14 +199,14 @@ pub(super) fn wall_contacts(
     totals
 }
 
-/// Contacts of particle `i` with every wall, one per coplanar patch of facets, pushed
-/// onto `chunk`.
 /// Whether particle `i` has facets of some wall in its list.
 #[inline]
 fn near_walls(world: &World, inputs: &WallInputs, i: usize) -> bool {
     (0..world.walls.len()).any(|w| !inputs.list.facets(i, w).is_empty())
 }
 
+/// Contacts of particle `i` with every wall, one per coplanar patch of facets, pushed
+/// onto `chunk`.
 fn particle_contacts(
     world: &World,
     i: usize,
