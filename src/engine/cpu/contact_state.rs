@@ -2,12 +2,12 @@
 //! history of every candidate pair and wall patch, and the overlap decisions that
 //! only change the cost.
 
+use super::overlap_plans::OverlapPlans;
 use crate::Real;
 use crate::contact::TangentialHistory;
 use crate::engine::backend::{ContactHistory, WallKey};
 use crate::engine::fast_hash::FastMap;
 use crate::engine::neighbours::NeighbourList;
-use crate::geometry::overlap::OverlapCache;
 use crate::world::World;
 
 /// Persistent contact state, aligned with a [`NeighbourList`].
@@ -22,9 +22,9 @@ pub(super) struct ContactState {
     /// Tangential history of each candidate pair.
     pub pair_history: Vec<TangentialHistory>,
     /// What each candidate pair's exact overlap decided at some pose: it changes the
-    /// cost, never the answer (see [`OverlapCache`]), so it is neither saved nor
-    /// carried over a list build.
-    pub overlap_plans: Vec<OverlapCache>,
+    /// cost, never the answer (see [`crate::geometry::overlap::OverlapCache`]), so it
+    /// is neither saved nor carried over a list build.
+    pub overlap_plans: OverlapPlans,
     /// History set from outside, to be matched to the pairs at the next list build.
     pending: Option<FastMap<(u64, u64), TangentialHistory>>,
     /// History of the particle–wall patches of the last step.
@@ -69,17 +69,10 @@ impl ContactState {
             None => self.pair_history_by_ids(list),
         };
         list.build(world, radii);
-        self.overlap_plans.clear();
         // Only polyhedron pairs use a plan: a world of spheres keeps none (a plan is a
         // few hundred bytes, written for every pair at every build).
-        if world
-            .body_types
-            .iter()
-            .any(|t| t.shape.as_polyhedron().is_some())
-        {
-            self.overlap_plans
-                .resize(list.pairs().len(), OverlapCache::default());
-        }
+        let polyhedra = (world.body_types.iter()).any(|t| t.shape.as_polyhedron().is_some());
+        (self.overlap_plans).reset(if polyhedra { list.pairs().len() } else { 0 });
         self.pair_history.clear();
         self.pair_history.extend(list.pairs().iter().map(|&pair| {
             carried

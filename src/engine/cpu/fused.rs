@@ -56,12 +56,20 @@ pub(super) fn pair_contacts_gathered(
     let with_plans = state.overlap_plans.len() == list.pairs().len();
     let mut spare = OverlapCache::default();
     let pairs = list.pairs();
-    let prefetch = PairPrefetch::new(&state.overlap_plans, pairs, &p.body_type, types);
+    let (plans, keeps_contact) = state.overlap_plans.split();
+    let prefetch = PairPrefetch::new(
+        (plans, keeps_contact),
+        &state.pair_history,
+        pairs,
+        &p.body_type,
+        types,
+    );
     let mut totals = ContactTotals::of_candidates(p, pairs);
     for first in (0..pairs.len()).step_by(BLOCK) {
         let block = first..pairs.len().min(first + BLOCK);
         let plans = with_plans.then(|| BlockPlans {
-            plans: &mut state.overlap_plans[block.clone()],
+            plans: &mut plans[block.clone()],
+            keeps_contact: &keeps_contact[first / BLOCK],
             prefetch,
             first,
         });

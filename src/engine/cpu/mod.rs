@@ -24,6 +24,7 @@ mod forces;
 mod fused;
 mod hertz;
 pub(crate) mod motion;
+mod overlap_plans;
 mod pair_results;
 mod pairs;
 mod patch;

@@ -1,6 +1,8 @@
 //! The particle-pair stages: every candidate pair's contact, in parallel over the flat
 //! pair array, then every particle gathering its pairs' forces in pair order.
 
+use std::sync::atomic::AtomicU64;
+
 use nalgebra::Vector3;
 use rayon::prelude::*;
 
@@ -8,6 +10,7 @@ use super::contact_state::ContactState;
 use super::dispatch::pair_geometry;
 use super::forces::{ContactForce, PairResult, RelativeMotion, pair_force};
 use super::hertz::{HertzInputs, rolling_inertia, round_contact_force, round_radius, sphere_pair};
+use super::overlap_plans::record;
 use super::pair_results::{BLOCK, BusyBits, PairResults};
 use super::prefetch::PairPrefetch;
 use super::type_table::TypeTable;
@@ -98,25 +101,30 @@ fn pair_contact(
     }
 }
 
-/// The result of candidate pair `[i, j]` (`radii`: bounding radii), its history
-/// replaced by the one its contact leaves (empty when they do not touch). Two
-/// passive particles (frozen or ghost) push on nothing that moves here: their pair
-/// is skipped.
+/// Whether candidate pair `[i, j]` may touch: their bounding spheres (`radii`)
+/// overlap and one of them moves. Two passive particles (frozen or ghost) push on
+/// nothing that moves here.
+#[inline(always)]
+fn near(p: &Particles, radii: &[Real], [i, j]: [u32; 2]) -> bool {
+    let (i, j) = (i as usize, j as usize);
+    let reach = radii[i] + radii[j];
+    ((p.position[j] - p.position[i]).norm_squared() < reach * reach)
+        & !(p.is_passive(i) & p.is_passive(j))
+}
+
+/// The result of candidate pair `[i, j]`, evaluated where it is [`near`], its history
+/// replaced by the one its contact leaves (empty when they do not touch).
 #[inline]
 pub(super) fn evaluate_pair(
     world: &World,
-    radii: &[Real],
     laws: &PairLaws,
-    [i, j]: [u32; 2],
+    ([i, j], near): ([u32; 2], bool),
     history: &mut TangentialHistory,
     plan: &mut OverlapCache,
 ) -> PairResult {
     let p = &world.particles;
     let (i, j) = (i as usize, j as usize);
-    let reach = radii[i] + radii[j];
-    let c = if !(p.is_passive(i) && p.is_passive(j))
-        && (p.position[j] - p.position[i]).norm_squared() < reach * reach
-    {
+    let c = if near {
         pair_contact(world, i, j, plan, history, laws)
     } else {
         None
@@ -151,12 +159,13 @@ pub(super) fn pair_contacts(
     let block = |b: usize,
                  (results, mask): (&mut [PairResult], &mut u64),
                  history: &mut [TangentialHistory],
-                 plans: Option<(&mut [OverlapCache], PairPrefetch)>,
+                 plans: Option<(&mut [OverlapCache], PairPrefetch, &[AtomicU64])>,
                  spare: &mut OverlapCache| {
         let first = b * BLOCK;
         let pairs = &pairs[first..first + results.len()];
-        let plans = plans.map(|(plans, prefetch)| BlockPlans {
+        let plans = plans.map(|(plans, prefetch, keeps_contact)| BlockPlans {
             plans,
+            keeps_contact: &keeps_contact[b],
             prefetch,
             first,
         });
@@ -172,21 +181,23 @@ pub(super) fn pair_contacts(
             },
         );
     };
+    let with_plans = state.overlap_plans.len() == pairs.len();
+    let (plans, keeps_contact) = state.overlap_plans.split();
+    let p = &world.particles;
+    let history = &state.pair_history;
+    let prefetch = PairPrefetch::new((plans, keeps_contact), history, pairs, &p.body_type, types);
     let blocks = results
         .blocks_mut(pairs.len())
         .zip(state.pair_history.par_chunks_mut(BLOCK))
         .enumerate();
-    if state.overlap_plans.len() == pairs.len() {
-        let p = &world.particles;
-        let prefetch = PairPrefetch::new(&state.overlap_plans, pairs, &p.body_type, types);
-        blocks
-            .zip(state.overlap_plans.par_chunks_mut(BLOCK))
-            .for_each_init(
-                OverlapCache::default,
-                |spare, ((b, (results, history)), plans)| {
-                    block(b, results, history, Some((plans, prefetch)), spare)
-                },
-            );
+    if with_plans {
+        blocks.zip(plans.par_chunks_mut(BLOCK)).for_each_init(
+            OverlapCache::default,
+            |spare, ((b, (results, history)), plans)| {
+                let plans = (plans, prefetch, keeps_contact);
+                block(b, results, history, Some(plans), spare)
+            },
+        );
     } else {
         // A world of spheres keeps no overlap plans (see `ContactState::rebuild`).
         blocks.for_each_init(OverlapCache::default, |spare, (b, (results, history))| {
@@ -198,6 +209,9 @@ pub(super) fn pair_contacts(
 /// The overlap plans of a block of pairs starting at pair `first` of the list.
 pub(super) struct BlockPlans<'a> {
     pub plans: &'a mut [OverlapCache],
+    /// The block's word of [`super::overlap_plans::OverlapPlans`]: which plans keep
+    /// a contact.
+    pub keeps_contact: &'a AtomicU64,
     pub prefetch: PairPrefetch<'a>,
     pub first: usize,
 }
@@ -205,7 +219,8 @@ pub(super) struct BlockPlans<'a> {
 /// Evaluates the pairs of one block (at most [`BLOCK`], with their history and, for
 /// polyhedra, their overlap plans; `spare` serves as the plan otherwise) that
 /// [`to_evaluate`] names, in pair order, handing each one's index in the block and
-/// result to `take`. Returns the mask of the pairs evaluated.
+/// result to `take`, and records which plans keep a contact. Returns the mask of
+/// the pairs evaluated.
 #[inline(always)]
 pub(super) fn evaluate_block(
     world: &World,
@@ -216,19 +231,28 @@ pub(super) fn evaluate_block(
     spare: &mut OverlapCache,
     mut take: impl FnMut(usize, PairResult),
 ) -> u64 {
-    let mask = to_evaluate(plans.is_none(), &world.particles, radii, pairs, history);
+    let p = &world.particles;
+    let mask = to_evaluate(plans.is_none(), p, radii, pairs, history);
+    // The pairs whose plan was read (near), and of them those that keep a contact.
+    let (mut read, mut kept) = (0u64, 0u64);
     for k in BusyBits(mask) {
         let plan = match &mut plans {
             Some(p) => {
-                p.prefetch.ahead(p.plans, p.first, k);
+                p.prefetch.ahead(p.first, k);
                 &mut p.plans[k]
             }
             None => &mut *spare,
         };
+        let near = near(p, radii, pairs[k]);
         take(
             k,
-            evaluate_pair(world, radii, laws, pairs[k], &mut history[k], plan),
+            evaluate_pair(world, laws, (pairs[k], near), &mut history[k], plan),
         );
+        read |= u64::from(near) << k;
+        kept |= u64::from(near && plan.keeps_contact()) << k;
+    }
+    if let Some(p) = &plans {
+        record(p.keeps_contact, read, kept);
     }
     mask
 }
@@ -255,8 +279,7 @@ fn to_evaluate(
 }
 
 /// The mask of the pairs of a block (at most [`BLOCK`], with their `history`) that
-/// have something to do: their bounding spheres overlap and one of them moves (the
-/// test [`evaluate_pair`] starts with), or their contact held a history that
+/// have something to do: they are [`near`], or their contact held a history that
 /// parting lets go. Found without a branch per pair: whether a pair touches is as
 /// good as a coin toss in a dense bed, and a mispredicted branch for every other
 /// candidate pair cost the sweep about a fifth of its time.
@@ -269,12 +292,8 @@ fn busy_pairs(
 ) -> u64 {
     debug_assert!(pairs.len() <= BLOCK && history.len() == pairs.len());
     let mut busy = 0u64;
-    for (k, (pair, history)) in pairs.iter().zip(history).enumerate() {
-        let [i, j] = pair.map(|x| x as usize);
-        let reach = radii[i] + radii[j];
-        let near = ((p.position[j] - p.position[i]).norm_squared() < reach * reach)
-            & !(p.is_passive(i) & p.is_passive(j));
-        busy |= u64::from(near | !history.is_empty()) << k;
+    for (k, (&pair, history)) in pairs.iter().zip(history).enumerate() {
+        busy |= u64::from(near(p, radii, pair) | !history.is_empty()) << k;
     }
     busy
 }

@@ -1,5 +1,5 @@
-//! Software prefetch of the pair stage: the kept overlap plans, and the shapes of
-//! the contacts they keep.
+//! Software prefetch of the pair stage: the kept overlap plans, the tangential
+//! histories, and the shapes of the contacts the plans keep.
 //!
 //! The pairs are swept in list order, but only those whose bounding spheres overlap
 //! read their plan, so the plans are read at an irregular stride that the hardware
@@ -7,30 +7,31 @@
 //! to memory (scene (d) of `talus bench`: a third of the pair stage). Asking a few
 //! pairs ahead hides that latency.
 //!
-//! In two stages: the first lines of a plan (what a pair apart reads) [`AHEAD`] pairs
-//! ahead; then, [`REST_AHEAD`] pairs ahead, where those lines say that the plan keeps
-//! a contact's decisions, the rest of it (the topology a contact evaluates) and what
-//! the contact reads of its two shapes (the templates, their vertices and planes,
-//! found through the [`TypeTable`] without reading the shapes). In the dense
-//! dodecahedron bed (`talus bench` (a)) the loads of the topology's labels and loops
-//! were a third of its evaluation's samples, and fetching the rest of the plan made
-//! a step 3–9 % faster on one thread. Where every particle has a shape of its own
-//! (scene (d)), a contact's reads of the shapes waited on memory link by link
-//! (template, then its vertices and planes): placing B's points took a tenth of the
-//! step.
+//! A plan's first lines (what a pair apart reads) are asked for [`AHEAD`] pairs
+//! ahead, and where the plan keeps a contact's decisions (a bit beside the plans
+//! says so: [`super::overlap_plans`]) the rest of it (the topology a contact
+//! evaluates) and what the contact reads of its two shapes (the templates, their
+//! vertices and planes, found through the [`TypeTable`] without reading the
+//! shapes). In the dense dodecahedron bed (`talus bench` (a)) the loads of the
+//! topology's labels and loops were a third of its evaluation's samples, and
+//! fetching the rest of the plan made a step 3–9 % faster on one thread. Where every
+//! particle has a shape of its own (scene (d)), a contact's reads of the shapes
+//! waited on memory link by link (template, then its vertices and planes): placing
+//! B's points took a tenth of the step. A pair's history (one line, read by every
+//! pair) is asked for with its plan: the hardware prefetchers alone left the dense
+//! bed 2–4 % slower, and with many shapes its load was a tenth of the pair stage.
 
 use std::ops::Range;
+use std::sync::atomic::AtomicU64;
 
+use super::overlap_plans::keeps_contact;
 use super::type_table::TypeTable;
+use crate::contact::TangentialHistory;
 use crate::geometry::overlap::OverlapCache;
 
 /// How many pairs ahead the plans are fetched: enough to cover a memory access at
 /// the rate pairs apart are swept (a few tens of nanoseconds each).
 const AHEAD: usize = 6;
-
-/// How many pairs ahead a contact's plan is fetched whole, with its shapes: its
-/// first lines, asked for `AHEAD − REST_AHEAD` pairs before, have then arrived.
-const REST_AHEAD: usize = 3;
 
 /// Where the plans lie, and how to find a pair's shapes, to prefetch from while the
 /// plans are borrowed elsewhere (the plans by address only: nothing is read through
@@ -39,6 +40,11 @@ const REST_AHEAD: usize = 3;
 pub(super) struct PairPrefetch<'a> {
     start: usize,
     len: usize,
+    /// Where the pairs' tangential histories lie (read by every pair, apart or not).
+    history: usize,
+    /// Per block of pairs, which plans keep a contact (see
+    /// [`super::overlap_plans::OverlapPlans`]).
+    keeps_contact: &'a [AtomicU64],
     /// The list's pairs, the particles' body types and the types' table.
     pairs: &'a [[u32; 2]],
     body_type: &'a [u32],
@@ -46,9 +52,11 @@ pub(super) struct PairPrefetch<'a> {
 }
 
 impl<'a> PairPrefetch<'a> {
-    /// Prefetches for the `plans` of the list's `pairs`, of particles of `body_type`.
+    /// Prefetches for the `plans` of the list's `pairs` (and which of them keep a
+    /// contact), of particles of `body_type`.
     pub(super) fn new(
-        plans: &[OverlapCache],
+        (plans, keeps_contact): (&[OverlapCache], &'a [AtomicU64]),
+        history: &[TangentialHistory],
         pairs: &'a [[u32; 2]],
         body_type: &'a [u32],
         types: &'a TypeTable,
@@ -56,34 +64,37 @@ impl<'a> PairPrefetch<'a> {
         PairPrefetch {
             start: plans.as_ptr().addr(),
             len: plans.len(),
+            history: history.as_ptr().addr(),
+            keeps_contact,
             pairs,
             body_type,
             types,
         }
     }
 
-    /// Starts fetching what pairs a few ahead of pair `k` of a block will read: the
-    /// first lines of pair `k + AHEAD`'s plan (that of the list, if there is one),
-    /// and, if pair `k + REST_AHEAD` keeps a contact, the rest of its plan and what
-    /// its contact reads of its shapes (in the block: `plans` are the block's, the
-    /// first of them pair `first` of the list).
+    /// Starts fetching what the pair [`AHEAD`] pairs after pair `k` of a block (the
+    /// first of which is pair `first` of the list) will read: its history, the first
+    /// lines of its plan, and, if the plan keeps a contact, the rest of it and what
+    /// its contact reads of its shapes.
     #[inline(always)]
-    pub(super) fn ahead(self, plans: &[OverlapCache], first: usize, k: usize) {
-        if first + k + AHEAD < self.len {
-            self.fetch_plan(first + k + AHEAD, 0..OverlapCache::HOT_BYTES);
+    pub(super) fn ahead(self, first: usize, k: usize) {
+        let pair = first + k + AHEAD;
+        if pair >= self.len {
+            return;
         }
-        let keeps = |k: usize| plans.get(k).is_some_and(OverlapCache::keeps_contact);
-        if keeps(k + REST_AHEAD) {
-            let pair = first + k + REST_AHEAD;
-            let hot = OverlapCache::HOT_BYTES.next_multiple_of(64);
-            self.fetch_plan(pair, hot..size_of::<OverlapCache>());
-            if !self.types.fetch_shapes() {
-                return;
-            }
+        let size = size_of::<TangentialHistory>();
+        fetch(self.history + pair * size..self.history + (pair + 1) * size);
+        let hot = OverlapCache::HOT_BYTES.next_multiple_of(64);
+        if !keeps_contact(self.keeps_contact, pair) {
+            self.fetch_plan(pair, 0..hot);
+            return;
+        }
+        self.fetch_plan(pair, 0..size_of::<OverlapCache>());
+        if self.types.fetch_shapes() {
             // The pairs are sorted by their first particle: where the pair before
             // kept a contact with the same first particle, its shape is on its way.
             let [i, j] = self.pairs[pair];
-            if !(keeps(k + REST_AHEAD - 1) && self.pairs[pair - 1][0] == i) {
+            if !(keeps_contact(self.keeps_contact, pair - 1) && self.pairs[pair - 1][0] == i) {
                 self.fetch_shape(i);
             }
             self.fetch_shape(j);
