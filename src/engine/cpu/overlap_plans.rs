@@ -5,8 +5,9 @@
 //! Reading that off the plan itself was a load of a line asked for only a few pairs
 //! before: where most candidates lie apart (a pair beyond its bounding spheres costs
 //! a few nanoseconds), it had not arrived, and that load held up the sweep (scene (d)
-//! of `talus bench`: a third of the pair stage's samples). One bit per pair, kept
-//! beside the plans, tells it from a word in the caches.
+//! of `talus bench`: a third of the pair sweep's samples with 20 shapes, a fifth
+//! with a body type per particle). One bit per pair, kept beside the plans, tells it
+//! from a word in the caches.
 
 use std::sync::atomic::{AtomicU64, Ordering};
 
