@@ -23,6 +23,7 @@ mod fluid;
 mod forces;
 mod fused;
 mod hertz;
+mod keep_awake;
 pub(crate) mod motion;
 mod overlap_plans;
 mod pair_results;
@@ -235,6 +236,7 @@ impl Backend for CpuBackend {
 
     /// One velocity-Verlet step: the stages in order.
     fn step(&mut self, world: &mut World, dt: Real) {
+        let _awake = keep_awake::KeepAwake::start();
         self.drift(world, dt);
         self.forces(world, dt);
         self.close(world, dt);
