@@ -144,16 +144,7 @@ mod tests {
     use super::*;
 
     fn material(young: Real, poisson: Real) -> Material {
-        Material {
-            name: String::new(),
-            density: 2500.0,
-            young,
-            poisson,
-            restitution: 0.5,
-            friction: 0.5,
-            rolling_friction: 0.0,
-            rolling_damping: 0.0,
-        }
+        Material::of_tests("", 2500.0, young, poisson)
     }
 
     #[test]

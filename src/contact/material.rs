@@ -153,6 +153,25 @@ pub fn pair_restitution(a: Real, b: Real) -> Real {
 }
 
 #[cfg(test)]
+impl Material {
+    /// A material of the library's unit tests: `name`, `density`, Young's modulus
+    /// `young` and Poisson's ratio `poisson`, restitution and friction 0.5, no
+    /// rolling resistance.
+    pub(crate) fn of_tests(name: &str, density: Real, young: Real, poisson: Real) -> Self {
+        Material {
+            name: name.into(),
+            density,
+            young,
+            poisson,
+            restitution: 0.5,
+            friction: 0.5,
+            rolling_friction: 0.0,
+            rolling_damping: 0.0,
+        }
+    }
+}
+
+#[cfg(test)]
 mod tests {
     use super::*;
 

@@ -288,16 +288,7 @@ mod tests {
     /// plus skin is listed.
     #[test]
     fn incidence_lists_name_each_pair_of_a_particle_with_its_role() {
-        let material = Material {
-            name: "m".into(),
-            density: 1000.0,
-            young: 1e7,
-            poisson: 0.3,
-            restitution: 0.5,
-            friction: 0.5,
-            rolling_friction: 0.0,
-            rolling_damping: 0.0,
-        };
+        let material = Material::of_tests("m", 1000.0, 1e7, 0.3);
         let mut world = World::default();
         world.body_types.push(BodyType::new(
             Shape::Sphere(Sphere::new(0.01).unwrap()),

@@ -69,7 +69,6 @@ pub(super) fn pair_contacts_gathered(
         let block = first..pairs.len().min(first + BLOCK);
         let plans = with_plans.then(|| BlockPlans {
             plans: &mut plans[block.clone()],
-            keeps_contact: &keeps_contact[first / BLOCK],
             prefetch,
             first,
         });

@@ -110,6 +110,7 @@ mod tests {
     use rayon::prelude::*;
 
     use super::*;
+    use crate::engine::cpu::test_pool;
 
     /// Waits up to a second for `waits` to have `n` threads awake, doing `work`
     /// meanwhile.
@@ -134,18 +135,11 @@ mod tests {
         std::thread::yield_now();
     }
 
-    fn pool(threads: usize) -> rayon::ThreadPool {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap()
-    }
-
     /// The other threads wait while the guard lives, do the pool's work meanwhile
     /// (the sums are right, nothing hangs), and stop once it is dropped.
     #[test]
     fn the_other_threads_wait_until_the_guard_is_dropped() {
-        pool(3).install(|| {
+        test_pool(3).install(|| {
             // Waits that no idle time ends: only the guard can.
             let guard = KeepAwake::start_with(Duration::from_secs(60));
             let waits = Arc::clone(guard.waits.as_ref().unwrap());
@@ -160,7 +154,7 @@ mod tests {
                 "they stop when it is dropped"
             );
         });
-        pool(1).install(|| assert!(KeepAwake::start().waits.is_none()));
+        test_pool(1).install(|| assert!(KeepAwake::start().waits.is_none()));
     }
 
     /// A guard that is never dropped lets its waits go once idle for their bound; back
@@ -168,7 +162,7 @@ mod tests {
     /// wait behind.
     #[test]
     fn waits_end_when_no_work_comes() {
-        pool(2).install(|| {
+        test_pool(2).install(|| {
             let forgotten = KeepAwake::start_with(Duration::from_millis(300));
             let waits = Arc::clone(forgotten.waits.as_ref().unwrap());
             std::mem::forget(forgotten);

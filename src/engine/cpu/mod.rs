@@ -292,3 +292,12 @@ impl Backend for CpuBackend {
     /// The CPU backend works on the host world itself.
     fn sync_to_host(&mut self, _world: &mut World) {}
 }
+
+/// A thread pool of `threads` for the unit tests.
+#[cfg(test)]
+fn test_pool(threads: usize) -> rayon::ThreadPool {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap()
+}

@@ -80,6 +80,7 @@ mod tests {
 
     use super::*;
     use crate::contact::Material;
+    use crate::engine::cpu::test_pool;
     use crate::engine::{Backend, CpuBackend};
     use crate::geometry::{Shape, generators};
     use crate::world::{BodyType, World};
@@ -90,11 +91,7 @@ mod tests {
     #[test]
     fn the_bits_say_what_the_plans_keep_step_after_step() {
         for threads in [1, 2] {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .unwrap();
-            pool.install(|| {
+            test_pool(threads).install(|| {
                 let mut world = pressed_rocks();
                 let (mut engine, dt) = (CpuBackend::default(), 1e-6);
                 engine.initialise(&mut world, dt);
@@ -115,16 +112,7 @@ mod tests {
     }
 
     fn pressed_rocks() -> World {
-        let material = Material {
-            name: "rock".into(),
-            density: 2500.0,
-            young: 1e7,
-            poisson: 0.25,
-            restitution: 0.5,
-            friction: 0.5,
-            rolling_friction: 0.0,
-            rolling_damping: 0.0,
-        };
+        let material = Material::of_tests("rock", 2500.0, 1e7, 0.25);
         let rock = generators::random_convex(14, 0.005, 0.3, 3).unwrap();
         let mut world = World {
             body_types: vec![BodyType::new(Shape::Polyhedron(rock.into()), &material, 0)],

@@ -1,8 +1,6 @@
 //! The particle-pair stages: every candidate pair's contact, in parallel over the flat
 //! pair array, then every particle gathering its pairs' forces in pair order.
 
-use std::sync::atomic::AtomicU64;
-
 use nalgebra::Vector3;
 use rayon::prelude::*;
 
@@ -159,13 +157,12 @@ pub(super) fn pair_contacts(
     let block = |b: usize,
                  (results, mask): (&mut [PairResult], &mut u64),
                  history: &mut [TangentialHistory],
-                 plans: Option<(&mut [OverlapCache], PairPrefetch, &[AtomicU64])>,
+                 plans: Option<(&mut [OverlapCache], PairPrefetch)>,
                  spare: &mut OverlapCache| {
         let first = b * BLOCK;
         let pairs = &pairs[first..first + results.len()];
-        let plans = plans.map(|(plans, prefetch, keeps_contact)| BlockPlans {
+        let plans = plans.map(|(plans, prefetch)| BlockPlans {
             plans,
-            keeps_contact: &keeps_contact[b],
             prefetch,
             first,
         });
@@ -182,36 +179,54 @@ pub(super) fn pair_contacts(
         );
     };
     let with_plans = state.overlap_plans.len() == pairs.len();
-    let (plans, keeps_contact) = state.overlap_plans.split();
-    let p = &world.particles;
-    let history = &state.pair_history;
-    let prefetch = PairPrefetch::new((plans, keeps_contact), history, pairs, &p.body_type, types);
-    let blocks = results
-        .blocks_mut(pairs.len())
-        .zip(state.pair_history.par_chunks_mut(BLOCK))
-        .enumerate();
+    let history = &mut state.pair_history;
     if with_plans {
-        blocks.zip(plans.par_chunks_mut(BLOCK)).for_each_init(
-            OverlapCache::default,
-            |spare, ((b, (results, history)), plans)| {
-                let plans = (plans, prefetch, keeps_contact);
-                block(b, results, history, Some(plans), spare)
-            },
-        );
+        let (plans, keeps_contact) = state.overlap_plans.split();
+        let body_type = &world.particles.body_type;
+        // The prefetch keeps where the histories lie; nothing is read through it.
+        let prefetch = PairPrefetch::new((plans, keeps_contact), history, pairs, body_type, types);
+        result_blocks(results, history, pairs.len())
+            .zip(plans.par_chunks_mut(BLOCK))
+            .for_each_init(
+                OverlapCache::default,
+                |spare, ((b, (results, history)), plans)| {
+                    block(b, results, history, Some((plans, prefetch)), spare)
+                },
+            );
     } else {
         // A world of spheres keeps no overlap plans (see `ContactState::rebuild`).
-        blocks.for_each_init(OverlapCache::default, |spare, (b, (results, history))| {
-            block(b, results, history, None, spare)
-        });
+        result_blocks(results, history, pairs.len())
+            .for_each_init(OverlapCache::default, |spare, (b, (results, history))| {
+                block(b, results, history, None, spare)
+            });
     }
+}
+
+/// A block of the pair stage: its number, its results with their mask, and its
+/// pairs' histories.
+type ResultBlock<'a> = (
+    usize,
+    (
+        (&'a mut [PairResult], &'a mut u64),
+        &'a mut [TangentialHistory],
+    ),
+);
+
+/// The blocks of `pairs` pairs' results (each with its mask) and histories, numbered.
+fn result_blocks<'a>(
+    results: &'a mut PairResults,
+    history: &'a mut [TangentialHistory],
+    pairs: usize,
+) -> impl IndexedParallelIterator<Item = ResultBlock<'a>> {
+    results
+        .blocks_mut(pairs)
+        .zip(history.par_chunks_mut(BLOCK))
+        .enumerate()
 }
 
 /// The overlap plans of a block of pairs starting at pair `first` of the list.
 pub(super) struct BlockPlans<'a> {
     pub plans: &'a mut [OverlapCache],
-    /// The block's word of [`super::overlap_plans::OverlapPlans`]: which plans keep
-    /// a contact.
-    pub keeps_contact: &'a AtomicU64,
     pub prefetch: PairPrefetch<'a>,
     pub first: usize,
 }
@@ -252,7 +267,7 @@ pub(super) fn evaluate_block(
         kept |= u64::from(near && plan.keeps_contact()) << k;
     }
     if let Some(p) = &plans {
-        record(p.keeps_contact, read, kept);
+        record(p.prefetch.keeps_contact_word(p.first), read, kept);
     }
     mask
 }

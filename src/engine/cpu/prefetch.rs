@@ -25,6 +25,7 @@ use std::ops::Range;
 use std::sync::atomic::AtomicU64;
 
 use super::overlap_plans::keeps_contact;
+use super::pair_results::BLOCK;
 use super::type_table::TypeTable;
 use crate::contact::TangentialHistory;
 use crate::geometry::overlap::OverlapCache;
@@ -70,6 +71,12 @@ impl<'a> PairPrefetch<'a> {
             body_type,
             types,
         }
+    }
+
+    /// The word of the block of pairs starting at pair `first` (a multiple of
+    /// [`BLOCK`]) that says which of their plans keep a contact.
+    pub(super) fn keeps_contact_word(self, first: usize) -> &'a AtomicU64 {
+        &self.keeps_contact[first / BLOCK]
     }
 
     /// Starts fetching what the pair [`AHEAD`] pairs after pair `k` of a block (the

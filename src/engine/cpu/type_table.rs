@@ -96,16 +96,7 @@ mod tests {
     use crate::world::BodyType;
 
     fn world_of(shapes: &[Shape]) -> World {
-        let material = Material {
-            name: "m".into(),
-            density: 2000.0,
-            young: 1e7,
-            poisson: 0.25,
-            restitution: 0.5,
-            friction: 0.5,
-            rolling_friction: 0.0,
-            rolling_damping: 0.0,
-        };
+        let material = Material::of_tests("m", 2000.0, 1e7, 0.25);
         let body_types = shapes
             .iter()
             .map(|s| BodyType::new(s.clone(), &material, 0))

@@ -310,16 +310,7 @@ mod tests {
     use crate::geometry::{Sphere, generators};
 
     fn material(young: Real, density: Real) -> Material {
-        Material {
-            name: String::new(),
-            density,
-            young,
-            poisson: 0.3,
-            restitution: 0.5,
-            friction: 0.5,
-            rolling_friction: 0.0,
-            rolling_damping: 0.0,
-        }
+        Material::of_tests("", density, young, 0.3)
     }
 
     /// The bounded search finds the shortest period of the full search over every pair
