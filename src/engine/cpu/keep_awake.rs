@@ -1,108 +1,148 @@
-//! The pool's other threads kept awake through a step.
+//! The pool's threads kept awake while steps follow one another.
 //!
 //! A step runs a handful of parallel stages with serial parts between them (the
 //! walls' merge, the totals). An idle rayon worker yields a few dozen times, then
 //! sleeps, and waking it goes through the host's scheduler: on the 2-core Intel VM of
 //! the benchmarks a region that finds the other worker asleep waits 80–110 µs for it
 //! (against 4 µs when it is awake), longer than a stage of a 5000-sphere step takes.
-//! So stages began on one thread and the second joined late or not at all. While a
-//! [`KeepAwake`] lives, every other thread of the current pool runs the pool's work
-//! as it appears and otherwise yields its core, as rayon's own idle rounds do, but
-//! without going to sleep: the pour of the LIGGGHTS comparison on two threads went
-//! from 4.5e6–4.6e6 to 4.9e6 particle-steps/s, the same bits.
+//! So stages began on one thread and the second joined late or not at all. While
+//! steps come, every thread of the pool waits in [`stay_awake`]: it runs the pool's
+//! work as it appears and otherwise yields its core, as rayon's own idle rounds do,
+//! but without going to sleep. The pour of the LIGGGHTS comparison on two threads
+//! went from 4.5e6–4.6e6 to 4.9e6 particle-steps/s, the same bits.
+//!
+//! The waits are started once and kept from step to step (a step allocates
+//! nothing: `tests/engine_allocation.rs`); they end when neither work nor a step
+//! has come for a while ([`MOST_IDLE`]), so a host that stops stepping gets its
+//! cores back soon after.
 //!
 //! # No deadlock
-//! The wait is a job on each other thread. A thread picks it up when idle, or while
-//! it waits inside a job of its own (a join whose other half was stolen): a wait
-//! there would hold that job, and the step that ends the wait may need the job. So a
-//! wait nested in a wait returns at once (the next step's wait, picked up inside the
-//! last step's), and any wait ends once it has found no work for [`MOST_IDLE`],
-//! which bounds the stall of the one case left (a wait picked up inside a job that is
-//! not a wait's) and of a guard that is never dropped.
+//! A wait is a job on each thread. A thread picks it up when idle, or while it waits
+//! inside a job of its own (a join whose other half was stolen): a wait there holds
+//! that job, and the step may need the job. So a wait returns at once on a thread
+//! that is stepping or already waiting, and otherwise ends once idle for
+//! [`MOST_IDLE`] (no step can begin while one is held up), which bounds the stall of
+//! the one case left: a wait picked up inside a job of a step on another thread.
 
 use std::cell::Cell;
 use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
 
-/// The longest a thread stays awake without finding work.
-const MOST_IDLE: Duration = Duration::from_millis(2);
+/// How long a wait lasts without work or a new step.
+const MOST_IDLE: Duration = Duration::from_millis(10);
 
 thread_local! {
-    /// Whether this thread is inside [`stay_awake`].
-    static AWAKE: Cell<bool> = const { Cell::new(false) };
+    /// Whether this thread is stepping (holds a [`Stepping`]) or inside a wait.
+    static BUSY: Cell<bool> = const { Cell::new(false) };
 }
 
-/// What a guard shares with its waits.
+/// What the waits share with the steps.
 #[derive(Debug, Default)]
 struct Waits {
-    /// Set when the guard is dropped.
-    done: AtomicBool,
-    /// Threads inside this guard's waits now.
-    awake: AtomicUsize,
+    /// Steps begun; a wait that sees it move is not idle.
+    steps: AtomicU64,
+    /// Waits started and not yet ended (those yet to start included).
+    live: AtomicUsize,
+    /// How many times the waits were started (for the tests).
+    starts: AtomicUsize,
 }
 
-/// Keeps the current pool's other threads from sleeping until it is dropped.
+/// Keeps the current pool's threads awake while steps follow one another.
 ///
-/// Invariant: `done` is set once the guard is dropped, and every wait it started
-/// ends at its next look at it.
+/// Invariant: `waits.live` counts the waits spawned and not ended; new ones are
+/// spawned only when none is left, so a run of steps spawns once.
 #[derive(Debug)]
 pub(super) struct KeepAwake {
-    /// `None` on one thread, where there is no one to keep awake.
-    waits: Option<Arc<Waits>>,
+    waits: Arc<Waits>,
+    most_idle: Duration,
+}
+
+impl Default for KeepAwake {
+    fn default() -> Self {
+        Self::with_most_idle(MOST_IDLE)
+    }
+}
+
+/// A copy starts waits of its own: two backends never share them.
+impl Clone for KeepAwake {
+    fn clone(&self) -> Self {
+        Self::with_most_idle(self.most_idle)
+    }
 }
 
 impl KeepAwake {
-    /// Starts every other thread of the current pool (every thread, called from
-    /// outside it) on a wait that runs the pool's jobs, until the guard is dropped.
-    pub(super) fn start() -> Self {
-        Self::start_with(MOST_IDLE)
+    fn with_most_idle(most_idle: Duration) -> Self {
+        KeepAwake {
+            waits: Arc::default(),
+            most_idle,
+        }
     }
 
-    /// [`Self::start`] with waits that end after `most_idle` without work.
-    fn start_with(most_idle: Duration) -> Self {
-        if rayon::current_num_threads() == 1 {
-            return KeepAwake { waits: None };
+    /// Marks a step's beginning on this thread, until the returned guard is dropped,
+    /// and starts the waits on the current pool's other threads if none is left.
+    pub(super) fn step(&self) -> Stepping {
+        let threads = rayon::current_num_threads();
+        if threads == 1 {
+            return Stepping { marked: false };
         }
-        let waits = Arc::new(Waits::default());
-        let me = rayon::current_thread_index();
-        let shared = Arc::clone(&waits);
-        rayon::spawn_broadcast(move |thread| {
-            if Some(thread.index()) != me {
-                stay_awake(&shared, most_idle);
-            }
-        });
-        KeepAwake { waits: Some(waits) }
+        let marked = !BUSY.replace(true);
+        self.waits.steps.fetch_add(1, Ordering::Relaxed);
+        if self.waits.live.load(Ordering::Acquire) == 0 {
+            // Every thread but this one (all of them, called from outside the pool).
+            let me = rayon::current_thread_index();
+            let others = threads - usize::from(me.is_some());
+            self.waits.live.fetch_add(others, Ordering::AcqRel);
+            self.waits.starts.fetch_add(1, Ordering::Relaxed);
+            let (waits, most_idle) = (Arc::clone(&self.waits), self.most_idle);
+            rayon::spawn_broadcast(move |thread| {
+                if Some(thread.index()) != me {
+                    stay_awake(&waits, most_idle);
+                    waits.live.fetch_sub(1, Ordering::AcqRel);
+                }
+            });
+        }
+        Stepping { marked }
     }
 }
 
-impl Drop for KeepAwake {
+/// A step in progress on this thread: a wait picked up here returns at once.
+#[derive(Debug)]
+pub(super) struct Stepping {
+    /// Whether this guard marked the thread (and so unmarks it).
+    marked: bool,
+}
+
+impl Drop for Stepping {
     fn drop(&mut self) {
-        if let Some(waits) = &self.waits {
-            waits.done.store(true, Ordering::Release);
+        if self.marked {
+            BUSY.set(false);
         }
     }
 }
 
-/// Runs the pool's jobs as they come until `waits.done`, or until none came for
-/// `most_idle`; returns at once inside another such wait (see the module docs).
+/// Runs the pool's jobs as they come until neither a job nor a step has come for
+/// `most_idle`; returns at once on a busy thread (see the module docs).
 fn stay_awake(waits: &Waits, most_idle: Duration) {
-    if AWAKE.replace(true) {
+    if BUSY.replace(true) {
         return;
     }
-    waits.awake.fetch_add(1, Ordering::Relaxed);
+    let mut steps = waits.steps.load(Ordering::Relaxed);
     let mut idle_since = Instant::now();
-    while !waits.done.load(Ordering::Acquire) {
+    loop {
         if rayon::yield_now() == Some(rayon::Yield::Executed) {
             idle_since = Instant::now();
+            continue;
+        }
+        let now = waits.steps.load(Ordering::Relaxed);
+        if now != steps {
+            (steps, idle_since) = (now, Instant::now());
         } else if idle_since.elapsed() > most_idle {
             break;
-        } else {
-            std::thread::yield_now();
         }
+        std::thread::yield_now();
     }
-    waits.awake.fetch_sub(1, Ordering::Relaxed);
-    AWAKE.set(false);
+    BUSY.set(false);
 }
 
 #[cfg(test)]
@@ -112,12 +152,12 @@ mod tests {
     use super::*;
     use crate::engine::cpu::test_pool;
 
-    /// Waits up to a second for `waits` to have `n` threads awake, doing `work`
+    /// Waits up to a second for `waits` to have `n` waits live, doing `work`
     /// meanwhile.
-    fn awake_become(waits: &Waits, n: usize, work: impl Fn()) -> bool {
+    fn live_become(waits: &Waits, n: usize, work: impl Fn()) -> bool {
         let start = Instant::now();
         while start.elapsed() < Duration::from_secs(1) {
-            if waits.awake.load(Ordering::Relaxed) == n {
+            if waits.live.load(Ordering::Acquire) == n {
                 return true;
             }
             work();
@@ -131,51 +171,48 @@ mod tests {
         assert_eq!(sum, 49_995_000);
     }
 
-    fn nothing() {
-        std::thread::yield_now();
-    }
-
-    /// The other threads wait while the guard lives, do the pool's work meanwhile
-    /// (the sums are right, nothing hangs), and stop once it is dropped.
+    /// Steps one after another start the waits once; the pool's work gets done
+    /// meanwhile (the sums are right, nothing hangs); once steps stop coming, the
+    /// waits end and the next step starts them again.
     #[test]
-    fn the_other_threads_wait_until_the_guard_is_dropped() {
+    fn a_run_of_steps_starts_the_waits_once() {
         test_pool(3).install(|| {
-            // Waits that no idle time ends: only the guard can.
-            let guard = KeepAwake::start_with(Duration::from_secs(60));
-            let waits = Arc::clone(guard.waits.as_ref().unwrap());
-            assert!(awake_become(&waits, 2, nothing), "the other two wait");
-            for _ in 0..100 {
+            let awake = KeepAwake::with_most_idle(Duration::from_millis(300));
+            for _ in 0..200 {
+                let _step = awake.step();
                 work();
             }
-            assert_eq!(waits.awake.load(Ordering::Relaxed), 2, "they wait on");
-            drop(guard);
+            assert_eq!(awake.waits.starts.load(Ordering::Relaxed), 1);
+            assert_eq!(awake.waits.live.load(Ordering::Acquire), 2, "they wait on");
             assert!(
-                awake_become(&waits, 0, work),
-                "they stop when it is dropped"
+                live_become(&awake.waits, 0, std::thread::yield_now),
+                "no step for 300 ms: the waits end"
             );
+            let _step = awake.step();
+            assert_eq!(awake.waits.starts.load(Ordering::Relaxed), 2);
         });
-        test_pool(1).install(|| assert!(KeepAwake::start().waits.is_none()));
+        test_pool(1).install(|| {
+            let awake = KeepAwake::default();
+            let _step = awake.step();
+            assert_eq!(awake.waits.starts.load(Ordering::Relaxed), 0);
+        });
     }
 
-    /// A guard that is never dropped lets its waits go once idle for their bound; back
-    /// to back guards, as a run's steps take them, get their work done and leave no
-    /// wait behind.
+    /// A wait run by a stepping thread (a join of the step taking it from the
+    /// thread's queue) returns at once instead of holding the step for its bound.
     #[test]
-    fn waits_end_when_no_work_comes() {
+    fn a_stepping_thread_does_not_wait() {
         test_pool(2).install(|| {
-            let forgotten = KeepAwake::start_with(Duration::from_millis(300));
-            let waits = Arc::clone(forgotten.waits.as_ref().unwrap());
-            std::mem::forget(forgotten);
-            assert!(awake_become(&waits, 1, nothing), "the other one waits");
-            assert!(awake_become(&waits, 0, nothing), "idle, the wait ends");
-            let mut last = None;
-            for _ in 0..200 {
-                let guard = KeepAwake::start();
-                let sum: u64 = (0..1000u64).into_par_iter().map(|x| x * 2).sum();
-                assert_eq!(sum, 999_000);
-                last = guard.waits.clone();
-            }
-            assert!(awake_become(&last.unwrap(), 0, nothing));
+            let awake = KeepAwake::with_most_idle(Duration::from_millis(300));
+            let stepping = awake.step();
+            let start = Instant::now();
+            stay_awake(&awake.waits, Duration::from_secs(60));
+            assert!(start.elapsed() < Duration::from_secs(1));
+            drop(stepping);
+            // Not stepping any more, the same call waits out its (short) bound.
+            let start = Instant::now();
+            stay_awake(&awake.waits, Duration::from_millis(50));
+            assert!(start.elapsed() >= Duration::from_millis(50));
         });
     }
 }

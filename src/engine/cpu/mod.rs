@@ -61,6 +61,8 @@ struct Workspace {
     walls: WallWork,
     /// Each body type's quotients of the integration.
     type_steps: motion::TypeSteps,
+    /// The pool's threads kept awake while steps follow one another.
+    awake: keep_awake::KeepAwake,
 }
 
 /// The CPU engine: step parameters, persistent contact state, the neighbour list, the
@@ -236,7 +238,7 @@ impl Backend for CpuBackend {
 
     /// One velocity-Verlet step: the stages in order.
     fn step(&mut self, world: &mut World, dt: Real) {
-        let _awake = keep_awake::KeepAwake::start();
+        let _stepping = self.work.awake.step();
         self.drift(world, dt);
         self.forces(world, dt);
         self.close(world, dt);
