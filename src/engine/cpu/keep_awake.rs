@@ -6,9 +6,9 @@
 //! the benchmarks a region that finds the other worker asleep waits 80–110 µs for it
 //! (against 4 µs when it is awake), longer than a stage of a 5000-sphere step takes.
 //! So stages began on one thread and the second joined late or not at all. While
-//! steps come, every thread of the pool waits in [`stay_awake`]: it runs the pool's
-//! work as it appears and otherwise yields its core, as rayon's own idle rounds do,
-//! but without going to sleep. The pour of the LIGGGHTS comparison on two threads
+//! steps come, every other thread of the pool waits in [`stay_awake`]: it runs the
+//! pool's work as it appears and otherwise yields its core, as rayon's own idle
+//! rounds do, but without going to sleep. The pour of the LIGGGHTS comparison on two threads
 //! went from 4.5e6–4.6e6 to 4.9e6 particle-steps/s, the same bits.
 //!
 //! The waits are started once and kept from step to step (a step allocates
@@ -17,7 +17,7 @@
 //! cores back soon after.
 //!
 //! # No deadlock
-//! A wait is a job on each thread. A thread picks it up when idle, or while it waits
+//! A wait is a job on each other thread. A thread picks it up when idle, or while it waits
 //! inside a job of its own (a join whose other half was stolen): a wait there holds
 //! that job, and the step may need the job. So a wait returns at once on a thread
 //! that is stepping or already waiting, and otherwise ends once idle for
