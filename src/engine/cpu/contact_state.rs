@@ -3,9 +3,10 @@
 //! only change the cost.
 
 use super::overlap_plans::OverlapPlans;
+use super::wall_history::WallHistory;
 use crate::Real;
 use crate::contact::TangentialHistory;
-use crate::engine::backend::{ContactHistory, WallKey};
+use crate::engine::backend::ContactHistory;
 use crate::engine::fast_hash::FastMap;
 use crate::engine::neighbours::NeighbourList;
 use crate::world::World;
@@ -28,7 +29,7 @@ pub(super) struct ContactState {
     /// History set from outside, to be matched to the pairs at the next list build.
     pending: Option<FastMap<(u64, u64), TangentialHistory>>,
     /// History of the particle–wall patches of the last step.
-    pub wall_history: FastMap<WallKey, TangentialHistory>,
+    pub wall_history: WallHistory,
 }
 
 impl ContactState {
@@ -48,9 +49,8 @@ impl ContactState {
     /// The whole history, sorted by key.
     pub fn history(&self, list: &NeighbourList) -> ContactHistory {
         let mut pairs: Vec<_> = self.pair_history_by_ids(list).into_iter().collect();
-        let mut walls: Vec<_> = self.wall_history.iter().map(|(k, h)| (*k, *h)).collect();
         pairs.sort_by_key(|e| e.0);
-        walls.sort_by_key(|e| e.0);
+        let walls = self.wall_history.to_sorted();
         ContactHistory { pairs, walls }
     }
 
@@ -58,7 +58,7 @@ impl ContactState {
     pub fn set_history(&mut self, history: ContactHistory, list: &mut NeighbourList) {
         self.pending = Some(history.pairs.into_iter().collect());
         list.invalidate();
-        self.wall_history = history.walls.into_iter().collect();
+        self.wall_history.set(history.walls);
     }
 
     /// Rebuilds `list` for `world` (`radii`: bounding radii), carrying each pair's

@@ -32,6 +32,7 @@ mod patch;
 mod prefetch;
 mod relative_motion;
 mod type_table;
+mod wall_history;
 mod walls;
 
 use std::ops::Range;

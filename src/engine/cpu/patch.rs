@@ -17,17 +17,32 @@ pub(super) enum Merge {
     Deepest,
 }
 
-/// The plane key of a facet with unit normal `n` through `point`, for a particle of
-/// bounding radius `radius`: facets sharing a plane (to 1e-9 in the normal and 1e-9
-/// radii in offset) share a key.
-#[inline]
-pub(super) fn plane_key(n: &Vector3<Real>, point: &Point3<Real>, radius: Real) -> [i64; 4] {
-    [
-        (n.x * 1e9).round() as i64,
-        (n.y * 1e9).round() as i64,
-        (n.z * 1e9).round() as i64,
-        (n.dot(&point.coords) / radius * 1e9).round() as i64,
-    ]
+/// A facet's plane as its patches' keys are made from it: facets sharing a plane (to
+/// 1e-9 in the unit normal and 1e-9 of a particle's bounding radius in offset) share a
+/// key. The normal's part of the key is the same for every particle and is rounded
+/// once, when the facet is placed.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct FacetPlane {
+    normal: [i64; 3],
+    /// Signed distance of the plane from the origin along the normal.
+    offset: Real,
+}
+
+impl FacetPlane {
+    /// The plane of unit normal `n` through `point`.
+    pub(super) fn new(n: &Vector3<Real>, point: &Point3<Real>) -> Self {
+        FacetPlane {
+            normal: n.map(|x| (x * 1e9).round() as i64).into(),
+            offset: n.dot(&point.coords),
+        }
+    }
+
+    /// The key of a patch on this plane for a particle of bounding radius `radius`.
+    #[inline]
+    pub(super) fn key(&self, radius: Real) -> [i64; 4] {
+        let [x, y, z] = self.normal;
+        [x, y, z, (self.offset / radius * 1e9).round() as i64]
+    }
 }
 
 /// The patches of one particle against one wall, being assembled. Buffers are kept

@@ -1,6 +1,7 @@
 //! The wall stage: every owned, moving particle against the facets its neighbour list
 //! names, one contact per coplanar patch, in parallel over fixed chunks of particles;
-//! then the contacts are added to particles, walls and facets in particle order.
+//! then the contacts are added to particles, walls and facets in particle order, and
+//! their history is kept in that order ([`WallHistory`]).
 //!
 //! The chunks keep their buffers between steps, so the stage allocates nothing once
 //! the buffers have grown to the bed's needs.
@@ -10,19 +11,19 @@ use std::ops::Range;
 use nalgebra::{Isometry3, Point3, Vector3};
 use rayon::prelude::*;
 
-use super::dispatch::{facet_geometry, pose_of};
+use super::dispatch::{ContactGeometry, facet_geometry, pose_of};
 use super::forces::{ContactForce, LawInputs, RelativeMotion, contact_force};
 use super::hertz::{HertzInputs, rolling_inertia, round_contact_force};
 use super::pairs::ContactTotals;
-use super::patch::{Merge, PatchSet, plane_key};
+use super::patch::{FacetPlane, Merge, PatchSet};
 use super::prefetch::fetch_shape;
+use super::relative_motion::velocity_at;
 use super::type_table::TypeTable;
+use super::wall_history::{WallEntry, WallHistory};
 use crate::Real;
-use crate::contact::TangentialHistory;
 use crate::engine::RoundLaw;
 use crate::engine::backend::WallKey;
-use crate::engine::fast_hash::FastMap;
-use crate::engine::laws::ContactLaws;
+use crate::engine::laws::{ContactLaws, SphereBody};
 use crate::engine::neighbours::NeighbourList;
 use crate::geometry::Shape;
 use crate::world::{Wall, World};
@@ -56,6 +57,9 @@ pub(super) struct WallChunk {
     contacts: Vec<WallContact>,
     shares: Vec<(u32, Real)>,
     patches: PatchSet,
+    /// The patches of the step before that this step did not find, with their
+    /// friction springs' energy.
+    ended: Vec<(WallKey, Real)>,
 }
 
 /// What the wall stage reads besides the world.
@@ -69,14 +73,15 @@ pub(super) struct WallInputs<'a> {
     pub dt: Real,
 }
 
-/// One wall's facets in world coordinates with their unit normals, as of the pose
-/// they were placed at: a fixed wall's are placed once, a moving wall's once a step,
-/// instead of once for every particle near a facet.
+/// One wall's facets in world coordinates with their unit normals and planes, as of
+/// the pose they were placed at: a fixed wall's are placed once, a moving wall's once
+/// a step, instead of once for every particle near a facet.
 #[derive(Clone, Debug, Default)]
 struct PlacedFacets {
     pose: Option<Isometry3<Real>>,
     triangles: Vec<[Point3<Real>; 3]>,
     normals: Vec<Vector3<Real>>,
+    planes: Vec<FacetPlane>,
 }
 
 impl PlacedFacets {
@@ -95,6 +100,10 @@ impl PlacedFacets {
                 .iter()
                 .map(|t| (t[1] - t[0]).cross(&(t[2] - t[0])).normalize()),
         );
+        self.planes.clear();
+        (self.planes).extend(
+            (self.triangles.iter().zip(&self.normals)).map(|(t, n)| FacetPlane::new(n, &t[0])),
+        );
     }
 }
 
@@ -105,7 +114,7 @@ pub(super) struct WallWork {
     /// Every wall's facets as placed in the world.
     placed: Vec<PlacedFacets>,
     /// The patches' history being written this step (swapped with the kept one).
-    next_history: FastMap<WallKey, TangentialHistory>,
+    next_history: WallHistory,
     /// The contacts that ended this step, with their friction springs' energy.
     ended: Vec<(WallKey, Real)>,
 }
@@ -117,7 +126,7 @@ pub(super) struct WallWork {
 pub(super) fn wall_contacts(
     world: &mut World,
     inputs: WallInputs,
-    history: &mut FastMap<WallKey, TangentialHistory>,
+    history: &mut WallHistory,
     work: &mut WallWork,
     touching: &mut [bool],
     mut totals: ContactTotals,
@@ -139,6 +148,7 @@ pub(super) fn wall_contacts(
     for (placed, wall) in work.placed.iter_mut().zip(&world.walls) {
         placed.update(wall);
     }
+    history.align(&world.particles.id);
     let w = &*world;
     let kept = &*history;
     let placed = &work.placed;
@@ -148,20 +158,23 @@ pub(super) fn wall_contacts(
         .for_each(|(c, chunk)| {
             chunk.contacts.clear();
             chunk.shares.clear();
+            chunk.ended.clear();
             let start = c * PARTICLES_PER_CHUNK;
             for i in start..(start + PARTICLES_PER_CHUNK).min(n) {
                 let ahead = i + SHAPE_AHEAD;
                 if inputs.types.fetch_shapes() && ahead < n && near_walls(w, &inputs, ahead) {
                     fetch_shape(inputs.types, w.particles.body_type[ahead]);
                 }
+                let (first, before) = (chunk.contacts.len(), kept.of_particle(i));
                 if !w.particles.is_passive(i) {
-                    particle_contacts(w, i, &inputs, placed, kept, chunk);
+                    particle_contacts(w, i, &inputs, placed, before, chunk);
                 }
+                chunk.end_missing(before, first);
             }
         });
 
     let next = &mut work.next_history;
-    next.clear();
+    next.begin(&world.particles.id);
     for chunk in &work.chunks[..chunks] {
         for contact in &chunk.contacts {
             let (i, c) = (contact.particle as usize, &contact.force);
@@ -183,16 +196,23 @@ pub(super) fn wall_contacts(
                 }
             }
             if !c.history.is_empty() {
-                next.insert(contact.key, c.history);
+                next.push(i, (contact.key, c.history));
             }
-            history.remove(&contact.key);
         }
     }
-    // What is left of the kept history are the contacts that ended: their friction
-    // springs are let go, in key order (the map's own order depends on its past).
+    next.finish();
+    // The contacts that ended let their friction springs go, in key order (the
+    // energies are summed in an order that does not depend on the chunks).
     work.ended.clear();
-    work.ended
-        .extend(history.iter().map(|(k, h)| (*k, h.spring_energy())));
+    (work.ended).extend(
+        history
+            .orphans()
+            .iter()
+            .map(|(k, h)| (*k, h.spring_energy())),
+    );
+    for chunk in &work.chunks[..chunks] {
+        work.ended.extend_from_slice(&chunk.ended);
+    }
     work.ended.sort_unstable_by_key(|e| e.0);
     totals.dissipated += work.ended.iter().map(|e| e.1).sum::<Real>();
     std::mem::swap(history, next);
@@ -205,14 +225,27 @@ fn near_walls(world: &World, inputs: &WallInputs, i: usize) -> bool {
     (0..world.walls.len()).any(|w| !inputs.list.facets(i, w).is_empty())
 }
 
+impl WallChunk {
+    /// Ends the patches of `before` (a particle's of the step before) that none of
+    /// the contacts from `first` on continues.
+    #[inline]
+    fn end_missing(&mut self, before: &[WallEntry], first: usize) {
+        for (key, h) in before {
+            if !self.contacts[first..].iter().any(|c| c.key == *key) {
+                self.ended.push((*key, h.spring_energy()));
+            }
+        }
+    }
+}
+
 /// Contacts of particle `i` with every wall, one per coplanar patch of facets, pushed
-/// onto `chunk`.
+/// onto `chunk`; `before` holds the particle's patches of the step before.
 fn particle_contacts(
     world: &World,
     i: usize,
     inputs: &WallInputs,
     placed: &[PlacedFacets],
-    history: &FastMap<WallKey, TangentialHistory>,
+    before: &[WallEntry],
     chunk: &mut WallChunk,
 ) {
     let WallInputs {
@@ -228,7 +261,7 @@ fn particle_contacts(
     }
     let p = &world.particles;
     let t = &world.body_types[p.body_type[i] as usize];
-    let radius = types.radius(p.body_type[i]);
+    let (radius, sphere) = (types.radius(p.body_type[i]), laws.sphere(p.body_type[i]));
     let pose = pose_of(world, i);
     let merge = match t.shape {
         Shape::Polyhedron(_) => Merge::Sum,
@@ -241,9 +274,10 @@ fn particle_contacts(
         }
         chunk.patches.clear();
         for &f in facets {
-            let (tri, n) = (
+            let (tri, n, plane) = (
                 &placed[w].triangles[f as usize],
                 &placed[w].normals[f as usize],
+                &placed[w].planes[f as usize],
             );
             // Walls are one-sided: a particle whose centroid is behind a facet's plane
             // has passed it (or the mesh faces the wrong way) and is not pushed back
@@ -255,9 +289,7 @@ fn particle_contacts(
                 continue;
             }
             if let Some(g) = facet_geometry(&t.shape, &pose, tri) {
-                chunk
-                    .patches
-                    .add(plane_key(n, &tri[0], radius), f, g, merge);
+                chunk.patches.add(plane.key(radius), f, g, merge);
             }
         }
         let law = laws.wall(p.body_type[i], wall.material);
@@ -266,10 +298,10 @@ fn particle_contacts(
             if !(g.area > 0.0) || !g.normal.iter().all(|x| x.is_finite()) {
                 continue;
             }
-            let motion =
-                RelativeMotion::of_wall(world, (i, &spin), wall, &g.point, &g.normal, law.inertia);
+            let motion = wall_motion(world, (i, &spin, sphere), wall, g, law.inertia);
             let wall_key = (p.id[i], w as u32, key);
-            let h = history.get(&wall_key).copied().unwrap_or_default();
+            let h =
+                (before.iter().find(|e| e.0 == wall_key)).map_or_else(Default::default, |e| e.1);
             let force = match (round, &t.shape) {
                 (RoundLaw::HertzMindlin { rolling }, Shape::Sphere(s)) => {
                     let law = HertzInputs {
@@ -306,5 +338,28 @@ fn particle_contacts(
                 shares: start..chunk.shares.len(),
             });
         }
+    }
+}
+
+/// Particle `i` (turning at `spin`; `sphere`: its body if it is a sphere) against
+/// `wall` at the contact `g`. A sphere's lever to its contact point lies along the
+/// normal, so its effective mass there is its mass: nothing is turned into its body
+/// frame.
+#[inline]
+fn wall_motion(
+    world: &World,
+    (i, spin, sphere): (usize, &Vector3<Real>, Option<&SphereBody>),
+    wall: &Wall,
+    g: &ContactGeometry,
+    inertia: Real,
+) -> RelativeMotion {
+    match sphere {
+        Some(s) => RelativeMotion {
+            velocity: velocity_at(world, i, spin, &g.point) - wall.velocity_at(&g.point),
+            spin: spin - wall.angular_velocity,
+            inverse_mass: s.inverse_mass,
+            inertia,
+        },
+        None => RelativeMotion::of_wall(world, (i, spin), wall, &g.point, &g.normal, inertia),
     }
 }
