@@ -344,3 +344,56 @@ fn every_change_of_the_host_reaches_the_backend() {
         assert!(calls.iter().any(|c| c == call), "no {call} call: {calls:?}");
     }
 }
+
+/// A sphere removed while its friction spring against a wall is stretched lets the
+/// spring go at the next step, as a contact that parts does: that step books the
+/// spring's energy as dissipated, to the bit, and the wall history no longer holds
+/// the patch.
+#[test]
+fn a_removed_particle_lets_its_wall_spring_go() {
+    let text = r#"
+[simulation]
+dt = 2e-5
+end_time = 1.0
+gravity = [0.0, 0.0, -9.81]
+[contact]
+law = "hertz_mindlin"
+[materials.glass]
+density = 2500.0
+young = 1e7
+poisson = 0.3
+restitution = 0.5
+friction = 0.5
+[shapes.ball]
+kind = "sphere"
+radius = 0.005
+[[wall]]
+name = "floor"
+material = "glass"
+geometry = { kind = "plane", centre = [0.0, 0.0, 0.0], normal = [0.0, 0.0, 1.0], size = 0.2 }
+[[particles]]
+kind = "list"
+shape = "ball"
+material = "glass"
+bodies = [
+    { position = [0.0, 0.0, 0.00499], velocity = [0.01, 0.0, 0.0] },
+    { position = [0.05, 0.0, 0.05] },
+]
+"#;
+    let scene = Scene::parse(text, Path::new("slide.toml")).unwrap();
+    let mut sim = Simulation::new(&scene);
+    let _ = sim.advance_to(2e-4, |_, _| ControlFlow::<()>::Continue(()));
+    let sliding = sim.world().particles.id[0];
+    let walls = sim.backend().contact_history().walls;
+    assert_eq!(walls.len(), 1, "the sliding sphere's patch: {walls:?}");
+    assert_eq!(walls[0].0.0, sliding);
+    let spring = walls[0].1.spring_energy();
+    assert!(spring > 0.0);
+
+    assert_eq!(sim.remove_particles(|w, k| w.particles.id[k] == sliding), 1);
+    sim.step();
+    // The other sphere falls free: the only energy let go is the spring's.
+    assert_eq!(sim.stats().contacts, 0);
+    assert_eq!(sim.stats().dissipated, spring);
+    assert!(sim.backend().contact_history().walls.is_empty());
+}
