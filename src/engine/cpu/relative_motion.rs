@@ -39,23 +39,22 @@ impl RelativeMotion {
         }
     }
 
-    /// Particle `i`, turning at `spin`, against `wall` at `point`, along `normal`
-    /// (the particle's angular velocity is taken once for all its wall contacts).
-    /// The wall's motion is prescribed: its velocity now is its velocity at the
-    /// step's end.
+    /// Particle `i`, turning at `spin`, against `wall` at `point`, where its inverse
+    /// effective mass is `inverse_mass` (the particle's angular velocity is taken once
+    /// for all its wall contacts). The wall's motion is prescribed: its velocity now
+    /// is its velocity at the step's end.
     #[inline]
     pub(super) fn of_wall(
         world: &World,
         (i, spin): (usize, &Vector3<Real>),
         wall: &Wall,
         point: &Point3<Real>,
-        normal: &Vector3<Real>,
-        inertia: Real,
+        (inverse_mass, inertia): (Real, Real),
     ) -> Self {
         RelativeMotion {
             velocity: velocity_at(world, i, spin, point) - wall.velocity_at(point),
             spin: spin - wall.angular_velocity,
-            inverse_mass: inverse_mass_at(world, i, point, normal),
+            inverse_mass,
             inertia,
         }
     }

@@ -11,19 +11,19 @@ use std::ops::Range;
 use nalgebra::{Isometry3, Point3, Vector3};
 use rayon::prelude::*;
 
-use super::dispatch::{ContactGeometry, facet_geometry, pose_of};
+use super::dispatch::{facet_geometry, pose_of};
 use super::forces::{ContactForce, LawInputs, RelativeMotion, contact_force};
 use super::hertz::{HertzInputs, rolling_inertia, round_contact_force};
 use super::pairs::ContactTotals;
 use super::patch::{FacetPlane, Merge, PatchSet};
 use super::prefetch::fetch_shape;
-use super::relative_motion::velocity_at;
+use super::relative_motion::inverse_mass_at;
 use super::type_table::TypeTable;
 use super::wall_history::{WallEntry, WallHistory};
 use crate::Real;
 use crate::engine::RoundLaw;
 use crate::engine::backend::WallKey;
-use crate::engine::laws::{ContactLaws, SphereBody};
+use crate::engine::laws::ContactLaws;
 use crate::engine::neighbours::NeighbourList;
 use crate::geometry::Shape;
 use crate::world::{Wall, World};
@@ -298,7 +298,19 @@ fn particle_contacts(
             if !(g.area > 0.0) || !g.normal.iter().all(|x| x.is_finite()) {
                 continue;
             }
-            let motion = wall_motion(world, (i, &spin, sphere), wall, g, law.inertia);
+            // A sphere's lever to its contact point lies along the normal, so its
+            // effective mass there is its mass: nothing is turned into its body frame.
+            let inverse_mass = sphere.map_or_else(
+                || inverse_mass_at(world, i, &g.point, &g.normal),
+                |s| s.inverse_mass,
+            );
+            let motion = RelativeMotion::of_wall(
+                world,
+                (i, &spin),
+                wall,
+                &g.point,
+                (inverse_mass, law.inertia),
+            );
             let wall_key = (p.id[i], w as u32, key);
             let h =
                 (before.iter().find(|e| e.0 == wall_key)).map_or_else(Default::default, |e| e.1);
@@ -338,28 +350,5 @@ fn particle_contacts(
                 shares: start..chunk.shares.len(),
             });
         }
-    }
-}
-
-/// Particle `i` (turning at `spin`; `sphere`: its body if it is a sphere) against
-/// `wall` at the contact `g`. A sphere's lever to its contact point lies along the
-/// normal, so its effective mass there is its mass: nothing is turned into its body
-/// frame.
-#[inline]
-fn wall_motion(
-    world: &World,
-    (i, spin, sphere): (usize, &Vector3<Real>, Option<&SphereBody>),
-    wall: &Wall,
-    g: &ContactGeometry,
-    inertia: Real,
-) -> RelativeMotion {
-    match sphere {
-        Some(s) => RelativeMotion {
-            velocity: velocity_at(world, i, spin, &g.point) - wall.velocity_at(&g.point),
-            spin: spin - wall.angular_velocity,
-            inverse_mass: s.inverse_mass,
-            inertia,
-        },
-        None => RelativeMotion::of_wall(world, (i, spin), wall, &g.point, &g.normal, inertia),
     }
 }
