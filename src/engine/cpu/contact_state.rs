@@ -62,13 +62,16 @@ impl ContactState {
     }
 
     /// Rebuilds `list` for `world` (`radii`: bounding radii), carrying each pair's
-    /// history over by the two particle ids.
+    /// history over by the two particle ids and grouping the wall patches' history by
+    /// the particles (a list is stale whenever the ids change, so the wall stage
+    /// finds it grouped between builds).
     pub fn rebuild(&mut self, list: &mut NeighbourList, world: &World, radii: &[Real]) {
         let carried = match self.pending.take() {
             Some(pending) => pending,
             None => self.pair_history_by_ids(list),
         };
         list.build(world, radii);
+        self.wall_history.align(&world.particles.id);
         // Only polyhedron pairs use a plan: a world of spheres keeps none (a plan is a
         // few hundred bytes, written for every pair at every build).
         let polyhedra = (world.body_types.iter()).any(|t| t.shape.as_polyhedron().is_some());

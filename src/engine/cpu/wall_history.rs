@@ -51,12 +51,17 @@ impl WallHistory {
         all
     }
 
+    /// Whether the patches are grouped by the particles of `ids`.
+    pub(super) fn is_aligned_to(&self, ids: &[u64]) -> bool {
+        self.aligned && self.ids == ids
+    }
+
     /// Groups the patches by the particles of `ids` (the world's particle ids, in
     /// index order) unless they are grouped so already: where particles were added,
     /// removed or reordered, or the history was set. Patches of ids not in the world
     /// become orphans.
     pub(super) fn align(&mut self, ids: &[u64]) {
-        if self.aligned && self.ids == ids {
+        if self.is_aligned_to(ids) {
             return;
         }
         self.sorted.clear();

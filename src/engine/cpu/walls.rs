@@ -148,7 +148,8 @@ pub(super) fn wall_contacts(
     for (placed, wall) in work.placed.iter_mut().zip(&world.walls) {
         placed.update(wall);
     }
-    history.align(&world.particles.id);
+    // Aligned at the list's builds: the world's ids do not change without one.
+    debug_assert!(history.is_aligned_to(&world.particles.id));
     let w = &*world;
     let kept = &*history;
     let placed = &work.placed;
