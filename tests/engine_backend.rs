@@ -8,7 +8,7 @@ use std::sync::{Arc, Mutex};
 
 use talus::Real;
 use talus::engine::{Backend, ContactHistory, CpuBackend, StageTimes, StepParams, StepStats};
-use talus::scene::{Scene, Simulation};
+use talus::scene::{Scene, Simulation, StateReader, StateWriter};
 use talus::world::{Particles, World};
 
 /// Four layers of dodecahedra, randomly turned and close enough to overlap, on the
@@ -343,6 +343,87 @@ fn every_change_of_the_host_reaches_the_backend() {
     for call in ["walls", "velocities", "removed", "restore"] {
         assert!(calls.iter().any(|c| c == call), "no {call} call: {calls:?}");
     }
+}
+
+/// A run restored from a saved state (through its bytes) builds its candidate lists
+/// at the same steps as the run it was saved from, starting from the saved build's
+/// positions: the same candidate pairs at every step, the first included. (A list
+/// built from the restored positions holds other candidates and is rebuilt at other
+/// steps.)
+#[test]
+fn a_restored_run_builds_its_lists_at_the_same_steps() {
+    let scene = Scene::parse(BOX, Path::new("box.toml")).unwrap();
+    let mut saved = Simulation::new(&scene);
+    let _ = saved.advance_to(1e-3, |_, _| ControlFlow::<()>::Continue(()));
+    let mut bytes = StateWriter::default();
+    saved.write_state(11, &mut bytes);
+    let mut restored = Simulation::new(&scene);
+    let bytes = bytes.into_bytes();
+    restored
+        .read_state(11, &mut StateReader::new(&bytes))
+        .unwrap();
+    // (list builds so far, candidate pairs) after every step.
+    let steps = |sim: &mut Simulation| {
+        let mut seen = Vec::new();
+        let _ = sim.advance_to(2.1e-2, |s, _| {
+            let stats = s.stats();
+            seen.push((stats.list_builds, stats.candidate_pairs));
+            ControlFlow::<()>::Continue(())
+        });
+        seen
+    };
+    let (a, b) = (steps(&mut saved), steps(&mut restored));
+    assert_eq!(a.len(), 2000);
+    // The steps (after the first) that build the lists.
+    let builds = |seen: &[(u64, usize)]| -> Vec<usize> {
+        (1..seen.len())
+            .filter(|&k| seen[k].0 > seen[k - 1].0)
+            .collect()
+    };
+    let built = builds(&a);
+    assert!((5..200).contains(&built.len()), "builds at steps {built:?}");
+    assert_eq!(built, builds(&b), "the steps that build the lists");
+    let candidates = |seen: &[(u64, usize)]| seen.iter().map(|s| s.1).collect::<Vec<_>>();
+    assert_eq!(candidates(&a), candidates(&b));
+    assert_eq!(
+        saved.world().particles.position,
+        restored.world().particles.position
+    );
+}
+
+/// A state of format 7 (before the lists' anchors were saved: version 8's bytes
+/// without the list, whose flag ends them) still restores, and steps on to the same
+/// bits (the contacts' order does not depend on when the lists were built).
+#[test]
+fn a_state_of_version_7_still_restores() {
+    let scene = Scene::parse(BOX, Path::new("box.toml")).unwrap();
+    let mut saved = Simulation::new(&scene);
+    let _ = saved.advance_to(1e-3, |_, _| ControlFlow::<()>::Continue(()));
+    let mut state = saved.snapshot();
+    assert!(state.list.is_some());
+    state.list = None;
+    let mut w = StateWriter::default();
+    state.write(3, &mut w);
+    let mut bytes = w.into_bytes();
+    assert_eq!(&bytes[..8], b"TALUSST8");
+    assert_eq!(bytes.split_off(bytes.len() - 8), [0; 8], "no list: flag 0");
+    bytes[7] = b'7';
+    let mut restored = Simulation::new(&scene);
+    restored
+        .read_state(3, &mut StateReader::new(&bytes))
+        .unwrap();
+    assert_eq!(restored.snapshot().list, None);
+    for sim in [&mut saved, &mut restored] {
+        let _ = sim.advance_to(3e-3, |_, _| ControlFlow::<()>::Continue(()));
+    }
+    assert_eq!(
+        saved.world().particles.position,
+        restored.world().particles.position
+    );
+    assert_eq!(
+        saved.world().particles.velocity,
+        restored.world().particles.velocity
+    );
 }
 
 /// A sphere removed while its friction spring against a wall is stretched lets the

@@ -5,7 +5,7 @@
 
 use super::CosimError;
 use super::component::{Component, ComponentState, Mode, RUNNING, WallDrive, WallMeans};
-use crate::scene::state_bytes::STATE_MAGIC;
+use crate::scene::state_bytes::starts_as_state;
 use crate::scene::{SimState, StateError, StateReader, StateWriter};
 
 impl Component {
@@ -84,7 +84,7 @@ impl Component {
             &[Mode::Initialisation, Mode::Step, Mode::Terminated],
             RUNNING,
         )?;
-        if !bytes.starts_with(STATE_MAGIC) {
+        if !starts_as_state(bytes) {
             return Err(StateError::NotAState.into());
         }
         let mut r = StateReader::checked(bytes)?;

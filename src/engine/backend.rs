@@ -39,6 +39,7 @@
 use std::fmt;
 use std::ops::Range;
 
+use super::neighbours::ListAnchors;
 use super::params::StepParams;
 use super::rank::Share;
 use super::stats::{StageTimes, StepStats};
@@ -125,6 +126,21 @@ pub trait Backend: Send + fmt::Debug {
     /// The host world was restored to a saved state whose history and last figures
     /// are given.
     fn restore(&mut self, world: &World, history: ContactHistory, stats: StepStats);
+
+    /// What the last build of the candidate lists started from, saved with a state
+    /// so that a run restored from it rebuilds its lists at the same steps; `None`
+    /// where the backend keeps no such lists.
+    fn list_anchors(&self) -> Option<ListAnchors> {
+        None
+    }
+
+    /// After [`Backend::restore`]: the saved state's [`Backend::list_anchors`], for
+    /// the next build of the lists to start from. A backend without such lists
+    /// builds its lists from the restored world (the same bits; builds at other
+    /// steps).
+    fn resume_lists(&mut self, anchors: ListAnchors) {
+        let _ = anchors;
+    }
 
     /// Brings the host world's particle arrays up to date.
     fn sync_to_host(&mut self, world: &mut World);

@@ -38,5 +38,6 @@ pub mod wire;
 
 pub use backend::{Backend, ContactHistory, WallKey};
 pub use cpu::CpuBackend;
+pub use neighbours::ListAnchors;
 pub use params::{REGULARISATION_LENGTH, RoundLaw, StepParams};
 pub use stats::{Stage, StageTimes, StepStats};

@@ -64,6 +64,16 @@ impl Incidence {
     }
 }
 
+/// What a build of the lists started from: each particle's id and position, in the
+/// order the world held them, and each wall's pose.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ListAnchors {
+    /// Id and position of every particle at the build.
+    pub particles: Vec<(u64, Point3<Real>)>,
+    /// Pose of every wall at the build.
+    pub wall_poses: Vec<Isometry3<Real>>,
+}
+
 /// Skin as a fraction of the smallest bounding radius when none is set.
 pub const DEFAULT_SKIN: Real = 0.2;
 
@@ -94,6 +104,9 @@ pub struct NeighbourList {
     built_skin: Real,
     valid: bool,
     builds: u64,
+    /// A saved build to start the next build from, where the particles have not
+    /// moved beyond its limits since ([`Self::resume_from`]).
+    resumed: Option<ListAnchors>,
 }
 
 impl NeighbourList {
@@ -105,6 +118,32 @@ impl NeighbourList {
     /// Candidate pairs, the particle of smaller id first, sorted by the two ids.
     pub fn pairs(&self) -> &[[u32; 2]] {
         &self.pairs
+    }
+
+    /// What the last build started from (or the saved build the next one will start
+    /// from); `None` when the lists are stale for other particles or walls.
+    pub fn anchors(&self) -> Option<ListAnchors> {
+        if !self.valid {
+            return self.resumed.clone();
+        }
+        Some(ListAnchors {
+            particles: self
+                .ids
+                .iter()
+                .copied()
+                .zip(self.anchors.iter().copied())
+                .collect(),
+            wall_poses: self.wall_poses.clone(),
+        })
+    }
+
+    /// Makes the next build start from `anchors` (a saved [`Self::anchors`]) if the
+    /// world then holds the same particles in the same order and walls as many, and
+    /// no particle has moved beyond the lists' limits from them; otherwise it starts
+    /// from the world as it is.
+    pub fn resume_from(&mut self, anchors: ListAnchors) {
+        self.valid = false;
+        self.resumed = Some(anchors);
     }
 
     /// Particles of the world the lists were built for.
@@ -175,19 +214,17 @@ impl NeighbourList {
         let skin = self.skin.unwrap_or_else(|| automatic_skin(radii));
         let skin = if skin.is_finite() { skin.max(0.0) } else { 0.0 };
         self.built_skin = skin;
+        let resumed = (self.resumed.take()).is_some_and(|a| self.anchor_at_saved(world, a));
+        if !resumed {
+            self.anchor_at(world);
+        }
 
         self.broad
-            .find_pairs(&p.position, radii, skin, &mut self.pairs);
+            .find_pairs(&self.anchors, radii, skin, &mut self.pairs);
         sort_by_ids(&mut self.pairs, &p.id);
         self.index_incident(n);
 
         let walls = world.walls.len();
-        self.wall_anchors.clear();
-        self.wall_anchors.extend(
-            (0..n)
-                .flat_map(|k| world.walls.iter().map(move |w| (k, w)))
-                .map(|(k, w)| w.pose.inverse_transform_point(&p.position[k])),
-        );
         let lists: Vec<Vec<u32>> = (0..n * walls)
             .into_par_iter()
             .map(|slot| {
@@ -206,16 +243,52 @@ impl NeighbourList {
             self.facets.extend_from_slice(&list);
             self.facet_starts.push(self.facets.len() as u32);
         }
+        self.valid = true;
+        self.builds += 1;
+    }
 
+    /// Takes the world's particles and walls as they are as the build's anchors.
+    fn anchor_at(&mut self, world: &World) {
+        let p = &world.particles;
         self.ids.clone_from(&p.id);
         self.anchors.clone_from(&p.position);
+        self.wall_poses.clear();
+        self.wall_poses.extend(world.walls.iter().map(|w| w.pose));
+        self.anchor_walls(world);
+    }
+
+    /// Takes `saved` as the build's anchors if they fit the world (see
+    /// [`Self::resume_from`]); returns whether they did.
+    fn anchor_at_saved(&mut self, world: &World, saved: ListAnchors) -> bool {
+        let p = &world.particles;
+        if saved.particles.len() != p.len()
+            || saved.wall_poses.len() != world.walls.len()
+            || saved.particles.iter().zip(&p.id).any(|(a, &id)| a.0 != id)
+        {
+            return false;
+        }
+        self.ids.clone_from(&p.id);
+        self.anchors.clear();
+        self.anchors.extend(saved.particles.iter().map(|a| a.1));
+        self.wall_poses = saved.wall_poses;
+        self.anchor_walls(world);
+        self.valid = true;
+        let fits = !self.is_stale(world);
+        self.valid = false;
+        fits
+    }
+
+    /// The anchors in every wall's frame at the build, and the walls' facet counts.
+    fn anchor_walls(&mut self, world: &World) {
+        self.wall_anchors.clear();
+        self.wall_anchors.extend(
+            (self.anchors.iter())
+                .flat_map(|x| self.wall_poses.iter().map(move |pose| (x, pose)))
+                .map(|(x, pose)| pose.inverse_transform_point(x)),
+        );
         self.wall_facets.clear();
         self.wall_facets
             .extend(world.walls.iter().map(|w| w.triangles.len()));
-        self.wall_poses.clear();
-        self.wall_poses.extend(world.walls.iter().map(|w| w.pose));
-        self.valid = true;
-        self.builds += 1;
     }
 
     /// Fills the per-particle incidence lists of the (sorted) pairs: each list

@@ -18,7 +18,7 @@ use super::remote_spec::{REMOTE_FILE, RemoteSpec};
 use super::slave::{FmuState, Slave};
 use crate::cosim::{Mode, VarRef, Variable, fingerprint, variable_table};
 use crate::scene::Scene;
-use crate::scene::state_bytes::STATE_MAGIC;
+use crate::scene::state_bytes::starts_as_state;
 use crate::transport::NodeConfig;
 use crate::transport::messages::{self as pb, call_request::Call as Request};
 
@@ -315,7 +315,7 @@ impl Slave for Remote {
     /// The node checks the bytes when they are restored; here only that they are a
     /// talus state at all.
     fn state_from_bytes(&self, bytes: &[u8]) -> Result<FmuState, String> {
-        if !bytes.starts_with(STATE_MAGIC) {
+        if !starts_as_state(bytes) {
             return Err("not a talus state".into());
         }
         Ok(FmuState::Remote(bytes.to_vec()))

@@ -16,7 +16,7 @@ use super::Simulation;
 use super::energy_ledger::EnergyLedger;
 use super::state_bytes::{StateError, StateReader, StateWriter};
 use crate::Real;
-use crate::engine::{ContactHistory, StepStats};
+use crate::engine::{ContactHistory, ListAnchors, StepStats};
 use crate::world::{CellShares, MomentumExchange, Particles};
 
 /// Everything of a [`Simulation`] that evolves.
@@ -46,6 +46,9 @@ pub struct SimState {
     pub inlets: Vec<InletState>,
     /// The tangential contact history.
     pub history: ContactHistory,
+    /// What the last build of the candidate lists started from (`None`: the lists
+    /// are built from the restored world).
+    pub list: Option<ListAnchors>,
     /// The fluid's inputs, shares and exchange, with a `[fluid]` section.
     pub fluid: Option<FluidState>,
 }
@@ -135,6 +138,7 @@ impl Simulation {
                 })
                 .collect(),
             history: self.backend.contact_history(),
+            list: self.backend.list_anchors(),
             fluid: world.fluid.as_ref().map(|f| FluidState {
                 velocity: f.velocity.clone(),
                 pressure_gradient: f.pressure_gradient.clone(),
@@ -201,6 +205,9 @@ impl Simulation {
         }
         self.backend
             .restore(&self.world, state.history.clone(), state.stats);
+        if let Some(anchors) = &state.list {
+            self.backend.resume_lists(anchors.clone());
+        }
         Ok(())
     }
 

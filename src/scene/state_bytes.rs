@@ -2,7 +2,8 @@
 //!
 //! What is saved is everything that evolves: particles (with this step's forces, which
 //! the next half kick uses, and whether they are frozen), wall poses, velocities and
-//! forces, the tangential contact history, inlet counters, box offsets and random
+//! forces, the tangential contact history, the positions and wall poses the
+//! candidate lists were last built from, inlet counters, box offsets and random
 //! generators, time, step count, the settling clock, the bed height last measured, and
 //! a coupled fluid's inputs, particle shares and exchange.
 //! What a scene defines once (materials, shapes, wall meshes and their facet grids) is
@@ -23,15 +24,23 @@ use thiserror::Error;
 use super::state::{FluidState, InletState, SimState, WallState};
 use crate::Real;
 use crate::contact::TangentialHistory;
-use crate::engine::ContactHistory;
 use crate::engine::StepStats;
+use crate::engine::{ContactHistory, ListAnchors};
 use crate::scene::energy_ledger::EnergyLedger;
 use crate::world::{CellShares, MomentumExchange, Particles};
 
 /// The header of a state; the digit is the format's version (4: states in checked
 /// containers; 5: the rolling spring in the contact history; 6: the fluid field; 7:
-/// the energy account).
-pub const STATE_MAGIC: &[u8; 8] = b"TALUSST7";
+/// the energy account; 8: what the candidate lists were last built from).
+pub const STATE_MAGIC: &[u8; 8] = b"TALUSST8";
+
+/// The header of version 7, still read: its lists are built from the restored world.
+const STATE_MAGIC_7: &[u8; 8] = b"TALUSST7";
+
+/// Whether `bytes` start with the header of a state this build reads.
+pub fn starts_as_state(bytes: &[u8]) -> bool {
+    bytes.starts_with(STATE_MAGIC) || bytes.starts_with(STATE_MAGIC_7)
+}
 
 /// Why bytes could not be restored as a state.
 #[derive(Debug, Error, PartialEq)]
@@ -308,6 +317,7 @@ impl SimState {
             write_history(w, h);
         }
         write_fluid(w, self.fluid.as_ref());
+        write_list(w, self.list.as_ref());
     }
 
     /// Reads a state written by [`SimState::write`] for the scene with this
@@ -315,9 +325,13 @@ impl SimState {
     /// [`StateReader::is_done`] or reads on). Whether it fits the scene (body types,
     /// walls, facets, inlets) is checked when it is restored.
     pub fn read(fingerprint: u64, r: &mut StateReader) -> Result<SimState, StateError> {
-        if !r.magic(STATE_MAGIC) {
+        let has_list = if r.magic(STATE_MAGIC) {
+            true
+        } else if r.magic(STATE_MAGIC_7) {
+            false
+        } else {
             return Err(StateError::NotAState);
-        }
+        };
         let found = r.u64()?;
         if found != fingerprint {
             return Err(StateError::OtherScene {
@@ -420,6 +434,7 @@ impl SimState {
             history.walls.push(((id, wall, plane), read_history(r)?));
         }
         let fluid = read_fluid(r)?;
+        let list = if has_list { read_list(r)? } else { None };
         Ok(SimState {
             time,
             dt,
@@ -433,9 +448,62 @@ impl SimState {
             walls,
             inlets,
             history,
+            list,
             fluid,
         })
     }
+}
+
+fn write_list(w: &mut StateWriter, list: Option<&ListAnchors>) {
+    let Some(list) = list else {
+        w.u64(0);
+        return;
+    };
+    w.u64(1);
+    w.u64(list.particles.len() as u64);
+    for (id, x) in &list.particles {
+        w.u64(*id);
+        w.vec3(&x.coords);
+    }
+    w.u64(list.wall_poses.len() as u64);
+    for pose in &list.wall_poses {
+        w.vec3(&pose.translation.vector);
+        w.quat(&pose.rotation);
+    }
+}
+
+fn read_list(r: &mut StateReader) -> Result<Option<ListAnchors>, StateError> {
+    match r.u64()? {
+        0 => return Ok(None),
+        1 => {}
+        x => return Err(StateError::Corrupt(format!("list flag {x}, not 0 or 1"))),
+    }
+    let mut list = ListAnchors::default();
+    let finite = |v: Vector3<Real>, what: &dyn Fn() -> String| {
+        if v.iter().all(|x| x.is_finite()) {
+            Ok(v)
+        } else {
+            Err(StateError::Corrupt(format!(
+                "{} is not finite: {v:?}",
+                what()
+            )))
+        }
+    };
+    for _ in 0..r.count(32)? {
+        let id = r.u64()?;
+        let x = finite(r.vec3()?, &|| {
+            format!("particle {id}'s position at the list build")
+        })?;
+        list.particles.push((id, Point3::from(x)));
+    }
+    for w in 0..r.count(56)? {
+        let t = finite(r.vec3()?, &|| {
+            format!("wall {w}'s position at the list build")
+        })?;
+        let q = r.quat()?;
+        (list.wall_poses).push(Isometry3::from_parts(Translation3::from(t), q));
+    }
+    Ok(Some(list))
 }
 
 fn write_vec3s(w: &mut StateWriter, v: &[Vector3<Real>]) {

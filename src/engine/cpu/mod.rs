@@ -43,7 +43,7 @@ use self::type_table::TypeTable;
 use self::walls::{WallInputs, WallWork};
 use super::backend::{Backend, ContactHistory};
 use super::laws::ContactLaws;
-use super::neighbours::NeighbourList;
+use super::neighbours::{ListAnchors, NeighbourList};
 use super::params::StepParams;
 use super::stats::{Stage, StageTimes, StepStats};
 use crate::Real;
@@ -290,6 +290,14 @@ impl Backend for CpuBackend {
             list_builds: self.stats.list_builds,
             ..stats
         };
+    }
+
+    fn list_anchors(&self) -> Option<ListAnchors> {
+        self.list.anchors()
+    }
+
+    fn resume_lists(&mut self, anchors: ListAnchors) {
+        self.list.resume_from(anchors);
     }
 
     /// The CPU backend works on the host world itself.
