@@ -321,10 +321,6 @@ impl NeighbourList {
     }
 }
 
-/// Orients every pair `[i, j]` (given with `i < j`) so that `id[i] < id[j]` and
-/// sorts the pairs by `(id[i], id[j])`. Where the ids ascend with the index
-/// (particles stored in the order of their ids) that is the order of the indices,
-/// and sorted as such.
 /// The skin when none is set: [`DEFAULT_SKIN`] times the smallest of the bounding
 /// `radii` (0 for none).
 pub fn automatic_skin(radii: &[Real]) -> Real {
@@ -332,6 +328,10 @@ pub fn automatic_skin(radii: &[Real]) -> Real {
     if skin.is_finite() { skin.max(0.0) } else { 0.0 }
 }
 
+/// Orients every pair `[i, j]` (given with `i < j`) so that `id[i] < id[j]` and
+/// sorts the pairs by `(id[i], id[j])`. Where the ids ascend with the index
+/// (particles stored in the order of their ids) that is the order of the indices,
+/// and sorted as such.
 fn sort_by_ids(pairs: &mut [[u32; 2]], id: &[u64]) {
     if id.is_sorted() {
         pairs.par_sort_unstable();
@@ -359,8 +359,8 @@ mod tests {
     /// Every particle's incidence list names exactly the listed pairs that hold it,
     /// ascending, each with the particle's role in it; and every pair within reach
     /// plus skin is listed.
-    #[test]
-    fn incidence_lists_name_each_pair_of_a_particle_with_its_role() {
+    /// 300 spheres of radius 0.01 at random in a 0.2 m cube.
+    fn random_spheres() -> World {
         let material = Material::of_tests("m", 1000.0, 1e7, 0.3);
         let mut world = World::default();
         world.body_types.push(BodyType::new(
@@ -378,6 +378,12 @@ mod tests {
             );
             world.particles.push(0, x, UnitQuaternion::identity(), id);
         }
+        world
+    }
+
+    #[test]
+    fn incidence_lists_name_each_pair_of_a_particle_with_its_role() {
+        let world = random_spheres();
         let radii = vec![0.01; 300];
         let mut list = NeighbourList {
             skin: Some(0.002),
@@ -402,5 +408,68 @@ mod tests {
                 assert_eq!(e.is_first(), pairs[e.pair()][0] as usize == k);
             }
         }
+    }
+
+    /// Lists resumed from a saved build are that build's lists while the particles
+    /// stay within its limits; a particle beyond them, or other particles, make the
+    /// build start from the world as it is.
+    #[test]
+    fn a_resumed_build_starts_from_the_saved_positions_while_they_hold() {
+        let mut world = random_spheres();
+        let radii = vec![0.01; 300];
+        let fresh = || NeighbourList {
+            skin: Some(0.002),
+            ..Default::default()
+        };
+        let mut saved = fresh();
+        saved.build(&world, &radii);
+        let anchors = saved.anchors().unwrap();
+        assert_eq!(anchors.particles.len(), 300);
+        // Every particle moved by 0.9 of half the skin, in turn along each axis.
+        for (k, x) in world.particles.position.iter_mut().enumerate() {
+            x[k % 3] += 0.9 * 0.001 * if k % 2 == 0 { 1.0 } else { -1.0 };
+        }
+        let mut moved = fresh();
+        moved.build(&world, &radii);
+        assert_ne!(
+            moved.pairs(),
+            saved.pairs(),
+            "another list from the new places"
+        );
+        let mut resumed = fresh();
+        resumed.resume_from(anchors.clone());
+        assert_eq!(resumed.anchors(), Some(anchors.clone()), "kept until built");
+        resumed.build(&world, &radii);
+        assert_eq!(resumed.pairs(), saved.pairs());
+        assert_eq!(resumed.anchors(), Some(anchors.clone()));
+        assert!(!resumed.is_stale(&world));
+
+        // One particle a little beyond half the skin (it moved along −z): built
+        // from the world.
+        world.particles.position[17].z -= 0.0002;
+        let mut beyond = fresh();
+        beyond.resume_from(anchors.clone());
+        beyond.build(&world, &radii);
+        assert_eq!(beyond.pairs(), moved_pairs(&world, &radii));
+        assert_ne!(beyond.anchors(), Some(anchors.clone()));
+
+        // Particles in another order: built from the world.
+        world.particles.position[17].z += 0.0002;
+        world.particles.id.swap(3, 4);
+        world.particles.reindex();
+        let mut other = fresh();
+        other.resume_from(anchors);
+        other.build(&world, &radii);
+        assert_eq!(other.pairs(), moved_pairs(&world, &radii));
+    }
+
+    /// The pairs of lists built from `world` as it is.
+    fn moved_pairs(world: &World, radii: &[Real]) -> Vec<[u32; 2]> {
+        let mut list = NeighbourList {
+            skin: Some(0.002),
+            ..Default::default()
+        };
+        list.build(world, radii);
+        list.pairs().to_vec()
     }
 }
