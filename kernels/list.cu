@@ -1,8 +1,9 @@
 // The candidate list of a world of spheres (engine/neighbours.rs, broad_phase.rs):
 // every pair (i, j), i < j, whose centres are closer than r_i + r_j + skin, in one
 // flat array of pairs sorted by (i, j), and for every particle the pairs that hold
-// it, ascending. With particles stored in the order of their ids (the device
-// stepper requires it) that is the CPU backend's list, pair for pair.
+// it in the order of its partners' space keys (cell code, then id). With particles
+// stored in the order of their ids (the device stepper requires it) that is the
+// CPU backend's list: the same pairs, each particle's in the same order.
 //
 // Particles are binned on a hashed grid of cells at least as wide as the largest
 // reach (so a particle's partners lie in the 27 cells about its own): the hash
@@ -178,8 +179,19 @@ extern "C" __global__ void fill_incident(unsigned pair_count, const unsigned* pa
     incident[atomicAdd(&fill[pairs[2 * e + 1]], 1u)] = e;
 }
 
-// One thread per particle: its incidences sorted by pair index.
-extern "C" __global__ void sort_incident(unsigned n, const unsigned* starts, unsigned* incident) {
+// Whether particle k's incidence `a` comes after `b`: by the partners' space keys
+// (cell code, then id; the slots are in id order), the CPU backend's order.
+static __device__ __forceinline__ bool partner_after(unsigned a, unsigned b, const unsigned* pairs,
+                                                     const unsigned long long* cell_code) {
+    unsigned pa = pairs[2 * (a & ~FIRST_ROLE) + ((a & FIRST_ROLE) ? 1 : 0)];
+    unsigned pb = pairs[2 * (b & ~FIRST_ROLE) + ((b & FIRST_ROLE) ? 1 : 0)];
+    return cell_code[pa] > cell_code[pb] || (cell_code[pa] == cell_code[pb] && pa > pb);
+}
+
+// One thread per particle: its incidences sorted by its partners' space keys.
+extern "C" __global__ void sort_incident(unsigned n, const unsigned* pairs,
+                                         const unsigned long long* cell_code,
+                                         const unsigned* starts, unsigned* incident) {
     unsigned k = blockIdx.x * blockDim.x + threadIdx.x;
     if (k >= n) {
         return;
@@ -188,7 +200,7 @@ extern "C" __global__ void sort_incident(unsigned n, const unsigned* starts, uns
     for (unsigned a = begin + 1; a < starts[k + 1]; ++a) {
         unsigned entry = incident[a];
         unsigned b = a;
-        for (; b > begin && (incident[b - 1] & ~FIRST_ROLE) > (entry & ~FIRST_ROLE); --b) {
+        for (; b > begin && partner_after(incident[b - 1], entry, pairs, cell_code); --b) {
             incident[b] = incident[b - 1];
         }
         incident[b] = entry;

@@ -1,12 +1,14 @@
 //! The Verlet lists change nothing but the cost: a run that keeps its candidate lists
 //! while particles move less than half the skin is bit for bit the run that rebuilds
-//! them every step (skin 0), through inlets adding particles, a turning drum wall and
-//! polyhedra, spheres and walls in contact together; and the lists are really kept.
+//! them every step (skin 0), through inlets adding particles, a turning drum wall,
+//! polyhedra, spheres and walls in contact together, and refreshes of the space
+//! order that store the particles anew; and the lists are really kept.
 
 use std::path::Path;
 
 use talus::engine::StepParams;
 use talus::scene::{Scene, Simulation};
+use talus::world::Particles;
 
 /// Dodecahedra and spheres poured by an inlet into a slowly turning closed drum
 /// whose end caps follow the shell.
@@ -97,6 +99,13 @@ fn kept_lists_give_the_same_run_as_lists_rebuilt_every_step() {
         kept.stats().contacts
     );
     assert_eq!(a.id, b.id);
+    // The space order's refreshes (every 1000 steps) coded every particle and
+    // stored them by cell, no longer by id.
+    let keys: Vec<_> = (0..a.owned()).map(|i| a.space_key(i)).collect();
+    assert!(keys.is_sorted(), "stored in the space order");
+    assert!(!a.id.is_sorted(), "stored by cell, not by id");
+    assert!(a.cell_code.iter().all(|&c| c != Particles::NO_CELL));
+    assert_eq!(a.cell_code, b.cell_code);
     assert_eq!(a.position, b.position);
     assert_eq!(a.orientation, b.orientation);
     assert_eq!(a.velocity, b.velocity);

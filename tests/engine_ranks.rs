@@ -14,7 +14,7 @@ use talus::engine::decomposition::Decomposition;
 use talus::engine::exchange::ThreadExchange;
 use talus::engine::rank::RankStepper;
 use talus::engine::{Backend, ContactHistory, CpuBackend, StepParams, StepStats};
-use talus::scene::{Scene, Simulation};
+use talus::scene::{SPACE_ORDER_INTERVAL, Scene, Simulation};
 use talus::world::World;
 
 /// The world of example `name` (with `overrides` appended) run to `until`, its step
@@ -251,7 +251,14 @@ start = 0.04
                         let mut rank = RankStepper::new(
                             exchange, layout, params, &mut world, &history, scene.dt,
                         );
-                        for _ in 0..steps {
+                        for k in 0..steps as u64 {
+                            // The space order refreshed as a simulation's driver does.
+                            if k > 0
+                                && k % SPACE_ORDER_INTERVAL == 0
+                                && world.refresh_space_order(false)
+                            {
+                                rank.particles_removed(&world);
+                            }
                             rank.step(&mut world, scene.dt);
                             placed += rank.insert(&mut world, &mut inlets, &mut next_id);
                         }

@@ -402,19 +402,23 @@ type Pose = (nalgebra::Point3<f64>, nalgebra::UnitQuaternion<f64>);
 /// A 15 cm bed of spheres (d = 5 mm) at N = 4 fed at 400 per second from a box
 /// that rides 2–5 cm above the bed surface, as far as the bed height of the [bed],
 /// with or without freezing the spheres more than 2 cm below the bed height;
-/// returns the settled simulation, each sphere's pose when it froze, and the bed.
-fn fill_from_above(freeze: bool) -> (talus::scene::Simulation, Vec<Option<Pose>>, Bed) {
+/// returns the settled simulation, each frozen sphere's pose when it froze (by id:
+/// the particles are stored anew as the space order is refreshed), and the bed.
+fn fill_from_above(
+    freeze: bool,
+) -> (
+    talus::scene::Simulation,
+    std::collections::BTreeMap<u64, Pose>,
+    Bed,
+) {
     let scene = scene_fed_from_above(freeze);
     let mut sim = talus::scene::Simulation::new(&scene);
-    let mut frozen_at = Vec::new();
+    let mut frozen_at = std::collections::BTreeMap::new();
     while !sim.is_settled() && sim.time() < 3.0 {
         sim.step();
         let p = &sim.world().particles;
-        frozen_at.resize(p.len(), None);
-        for (i, at) in frozen_at.iter_mut().enumerate() {
-            if p.frozen[i] && at.is_none() {
-                *at = Some((p.position[i], p.orientation[i]));
-            }
+        for i in (0..p.len()).filter(|&i| p.frozen[i]) {
+            (frozen_at.entry(p.id[i])).or_insert((p.position[i], p.orientation[i]));
         }
     }
     assert!(sim.is_settled(), "not at rest at {} s", sim.time());
@@ -520,12 +524,15 @@ fn a_bed_fed_from_above_with_its_buried_part_frozen() {
             for (x, _) in p.position.iter().zip(&p.frozen).filter(|(_, f)| **f) {
                 assert!(x.z + 0.5 * d < height - depth + d, "frozen at {x}");
             }
-            for (i, pose) in frozen_at.iter().enumerate() {
-                if let Some(pose) = pose {
-                    assert_eq!((p.position[i], p.orientation[i]), *pose, "sphere {i} moved");
-                }
+            for (&id, pose) in &frozen_at {
+                let i = p.index_of(id).unwrap();
+                assert_eq!(
+                    (p.position[i], p.orientation[i]),
+                    *pose,
+                    "sphere {id} moved"
+                );
             }
-            assert_eq!(frozen, frozen_at.iter().flatten().count());
+            assert_eq!(frozen, frozen_at.len());
         } else {
             assert_eq!(frozen, 0);
         }

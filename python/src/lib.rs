@@ -419,7 +419,9 @@ impl Scene {
         self.with_world(|w| w.particles.owned())
     }
 
-    /// Particle ids, `(n,)`, in the order of the other particle arrays.
+    /// Particle ids, `(n,)`, in the order of the other particle arrays. That order
+    /// changes every 1000 steps (the particles are stored by their place in space):
+    /// match rows of different steps by id.
     #[getter]
     fn ids<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<u64>>> {
         let ids = self.with_world(|w| w.particles.id[..w.particles.owned()].to_vec())?;

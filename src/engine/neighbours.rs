@@ -13,15 +13,17 @@
 //! spheres overlap, and every facet a particle's bounding sphere can reach, is listed.
 //!
 //! # Order
-//! A pair's first particle is the one of smaller id, and pairs are sorted by the
-//! ids of their two particles; each particle's facets are sorted by index. So the
-//! contacts found through the lists come in an order that depends on the state
-//! alone, neither on when the lists were built (a run restored from a saved state
-//! continues bit for bit) nor on where the particles lie in the arrays: a pair is
-//! evaluated with the same particle first, and each particle gathers its pairs in
-//! the order of its partners' ids, whether the particles are stored in the order of
-//! their ids or not (a rank of a domain decomposition keeps its own particles
-//! first and copies of its neighbours' after them).
+//! Pairs are sorted by the space keys of their two particles (the smaller, then the
+//! larger: the cell code of the particle's place at the last refresh of the space
+//! order, then its id, see [`crate::world::SpaceOrder`]), and a pair's first
+//! particle is the one of smaller id; each particle's facets are sorted by index.
+//! So the contacts found through the lists come in an order that depends on the
+//! state alone, neither on when the lists were built (a run restored from a saved
+//! state continues bit for bit) nor on where the particles lie in the arrays: a pair
+//! is evaluated with the same particle first, and each particle gathers its pairs
+//! in the order of its partners' keys, whether the particles are stored in that
+//! order or not (a rank of a domain decomposition keeps its own particles first and
+//! copies of its neighbours' after them).
 //!
 //! # Why
 //! Rebuilding the grid, counting and writing the pairs every step cost as much as the
@@ -33,7 +35,7 @@ use rayon::prelude::*;
 
 use super::broad_phase::BroadPhase;
 use crate::Real;
-use crate::world::World;
+use crate::world::{Particles, World};
 
 /// One particle's share in a listed pair: the pair's index into
 /// [`NeighbourList::pairs`] and whether the particle is the pair's first (`i` of
@@ -83,10 +85,11 @@ pub struct NeighbourList {
     /// Skin width; `None`: [`DEFAULT_SKIN`] times the smallest bounding radius.
     pub skin: Option<Real>,
     broad: BroadPhase,
-    /// Candidate pairs `[i, j]`, `id[i] < id[j]`, sorted by `(id[i], id[j])`.
+    /// Candidate pairs `[i, j]`, `id[i] < id[j]`, sorted by the space keys of their
+    /// particles (the smaller, then the larger).
     pairs: Vec<[u32; 2]>,
     /// `incident[incident_starts[k]..incident_starts[k + 1]]`: the pairs holding
-    /// particle `k`, ascending (so its partners come in the order of their ids).
+    /// particle `k`, ascending (so its partners come in the order of their keys).
     incident_starts: Vec<u32>,
     incident: Vec<Incidence>,
     /// `facets[facet_starts[k * walls + w]..facet_starts[k * walls + w + 1]]`: the
@@ -115,7 +118,8 @@ impl NeighbourList {
         self.valid = false;
     }
 
-    /// Candidate pairs, the particle of smaller id first, sorted by the two ids.
+    /// Candidate pairs, the particle of smaller id first, sorted by the space keys
+    /// of the two particles (the smaller, then the larger).
     pub fn pairs(&self) -> &[[u32; 2]] {
         &self.pairs
     }
@@ -221,7 +225,7 @@ impl NeighbourList {
 
         self.broad
             .find_pairs(&self.anchors, radii, skin, &mut self.pairs);
-        sort_by_ids(&mut self.pairs, &p.id);
+        sort_pairs(&mut self.pairs, p);
         self.index_incident(n);
 
         let walls = world.walls.len();
@@ -292,7 +296,7 @@ impl NeighbourList {
     }
 
     /// Fills the per-particle incidence lists of the (sorted) pairs: each list
-    /// ascending, so a particle meets its partners in the order of their ids.
+    /// ascending, so a particle meets its partners in the order of their keys.
     fn index_incident(&mut self, n: usize) {
         assert!(
             self.pairs.len() < Incidence::FIRST as usize,
@@ -328,22 +332,29 @@ pub fn automatic_skin(radii: &[Real]) -> Real {
     if skin.is_finite() { skin.max(0.0) } else { 0.0 }
 }
 
-/// Orients every pair `[i, j]` (given with `i < j`) so that `id[i] < id[j]` and
-/// sorts the pairs by `(id[i], id[j])`. Where the ids ascend with the index
-/// (particles stored in the order of their ids) that is the order of the indices,
-/// and sorted as such.
-fn sort_by_ids(pairs: &mut [[u32; 2]], id: &[u64]) {
-    if id.is_sorted() {
+/// Sorts the pairs (each given with `i < j`) by the space keys of their two
+/// particles, the smaller first (see [`crate::world::SpaceOrder`]), then orients
+/// each so that its first particle has the smaller id (a contact is evaluated from
+/// that side, and its history kept under it, whatever the keys). Where the keys
+/// ascend with the index (particles stored in key order) that is the order of the
+/// indices, and sorted as such.
+fn sort_pairs(pairs: &mut [[u32; 2]], p: &Particles) {
+    let key = |i: u32| p.space_key(i as usize);
+    if (0..p.len()).map(|i| p.space_key(i)).is_sorted() {
         pairs.par_sort_unstable();
     } else {
-        let key = |&[i, j]: &[u32; 2]| (id[i as usize], id[j as usize]);
         pairs.par_iter_mut().for_each(|pair| {
-            if id[pair[0] as usize] > id[pair[1] as usize] {
+            if key(pair[0]) > key(pair[1]) {
                 pair.swap(0, 1);
             }
         });
-        pairs.par_sort_unstable_by_key(key);
+        pairs.par_sort_unstable_by_key(|&[i, j]| (key(i), key(j)));
     }
+    pairs.par_iter_mut().for_each(|pair| {
+        if p.id[pair[0] as usize] > p.id[pair[1] as usize] {
+            pair.swap(0, 1);
+        }
+    });
 }
 
 #[cfg(test)]
@@ -356,9 +367,6 @@ mod tests {
     use crate::geometry::{Shape, Sphere};
     use crate::world::BodyType;
 
-    /// Every particle's incidence list names exactly the listed pairs that hold it,
-    /// ascending, each with the particle's role in it; and every pair within reach
-    /// plus skin is listed.
     /// 300 spheres of radius 0.01 at random in a 0.2 m cube.
     fn random_spheres() -> World {
         let material = Material::of_tests("m", 1000.0, 1e7, 0.3);
@@ -381,6 +389,9 @@ mod tests {
         world
     }
 
+    /// Every particle's incidence list names exactly the listed pairs that hold it,
+    /// ascending, each with the particle's role in it; and every pair within reach
+    /// plus skin is listed.
     #[test]
     fn incidence_lists_name_each_pair_of_a_particle_with_its_role() {
         let world = random_spheres();
@@ -407,6 +418,56 @@ mod tests {
             for e in list.incident(k) {
                 assert_eq!(e.is_first(), pairs[e.pair()][0] as usize == k);
             }
+        }
+    }
+
+    /// With the particles coded in the space order, pairs are sorted by their
+    /// particles' keys and evaluated from the particle of smaller id, and each
+    /// particle meets its partners in the order of their keys: the same pairs, in
+    /// the same order, whether the particles are stored by id or by key.
+    #[test]
+    fn pairs_follow_the_space_keys_wherever_the_particles_are_stored() {
+        let radii = vec![0.01; 300];
+        let built = |world: &World| {
+            let mut list = NeighbourList {
+                skin: Some(0.002),
+                ..Default::default()
+            };
+            list.build(world, &radii);
+            list
+        };
+        let mut by_id = random_spheres();
+        by_id.refresh_space_order(false);
+        let mut by_key = by_id.clone();
+        by_key.refresh_space_order(true);
+        let (a, b) = (&by_id.particles, &by_key.particles);
+        assert!(a.id.is_sorted() && !b.id.is_sorted(), "stored two ways");
+        let distinct: std::collections::HashSet<_> = a.cell_code.iter().collect();
+        assert!(
+            distinct.len() > 50,
+            "{} cells: the keys order",
+            distinct.len()
+        );
+
+        let (la, lb) = (built(&by_id), built(&by_key));
+        let ids = |p: &Particles, l: &NeighbourList| -> Vec<[u64; 2]> {
+            (l.pairs().iter())
+                .map(|&[i, j]| [p.id[i as usize], p.id[j as usize]])
+                .collect()
+        };
+        let pairs = ids(a, &la);
+        assert_eq!(pairs, ids(b, &lb), "the same pairs in the same order");
+        let key = |id: u64| a.space_key(a.index_of(id).unwrap());
+        let sort_key = |&[x, y]: &[u64; 2]| (key(x).min(key(y)), key(x).max(key(y)));
+        assert!(pairs.iter().all(|[x, y]| x < y), "the smaller id first");
+        assert!(pairs.is_sorted_by_key(sort_key), "sorted by the keys");
+        assert!(!pairs.is_sorted(), "not by the ids");
+        for k in 0..300 {
+            let partners: Vec<(u64, u64)> = (la.incident(k).iter())
+                .map(|e| la.pairs()[e.pair()][usize::from(e.is_first())] as usize)
+                .map(|j| a.space_key(j))
+                .collect();
+            assert!(partners.is_sorted(), "particle {k}: {partners:?}");
         }
     }
 

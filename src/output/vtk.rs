@@ -206,8 +206,11 @@ pub fn write_fluid(world: &World, path: &Path) -> io::Result<()> {
     let grid = &fluid.grid;
     let p = &world.particles;
     let mut drag = vec![nalgebra::Vector3::zeros(); grid.len()];
-    for (i, f) in fluid.exchange.drag.iter().enumerate().take(p.owned()) {
-        fluid.weights(i, p.id[i], &p.position[i], |c, w| drag[c] += f * w);
+    // Summed by id: the same bits whatever the order the particles are stored in.
+    for i in p.owned_by_id() {
+        if let Some(f) = fluid.exchange.drag.get(i) {
+            fluid.weights(i, p.id[i], &p.position[i], |c, w| drag[c] += f * w);
+        }
     }
     let vectors = |name: &str, v: &[nalgebra::Vector3<Real>]| Array::F32 {
         name: name.into(),
@@ -284,10 +287,12 @@ pub fn write_particles(world: &World, path: &Path, sphere_points: bool) -> io::R
                 Shape::Sphere(_)
             )
     };
-    // The points' cells first (VTK's order of verts before polygons), then the rest.
-    let order = (0..p.owned())
+    // The points' cells first (VTK's order of verts before polygons), then the rest,
+    // each by id (whatever the order the particles are stored in).
+    let by_id = p.owned_by_id();
+    let order = (by_id.iter().copied())
         .filter(|&i| is_point(i))
-        .chain((0..p.owned()).filter(|&i| !is_point(i)));
+        .chain(by_id.iter().copied().filter(|&i| !is_point(i)));
     for i in order {
         let t = &world.body_types[p.body_type[i] as usize];
         let pose = nalgebra::Isometry3::from_parts(p.position[i].coords.into(), p.orientation[i]);

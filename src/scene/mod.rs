@@ -33,7 +33,7 @@ pub use error::{FieldError, FieldPath, FieldSegment, SceneError};
 pub use fluid_coupling::FluidError;
 pub use plan::Plan;
 pub use rank_states::ShareState;
-pub use simulation::{Simulation, StepReport};
+pub use simulation::{SPACE_ORDER_INTERVAL, Simulation, StepReport};
 pub use spec::SceneSpec;
 pub use state::{FluidState, InletState, SimState, WallState};
 pub use state_bytes::{StateError, StateReader, StateWriter};

@@ -63,6 +63,12 @@ pub struct Simulation {
 /// the steps in between.
 pub const BED_HEIGHT_INTERVAL: Real = 5e-3;
 
+/// Steps between two refreshes of the space order (see
+/// [`crate::world::SpaceOrder`]): a particle of a pour crosses a cell in a few
+/// hundred steps at the suggested step, one of a bed never; a refresh costs about
+/// one build of the lists.
+pub const SPACE_ORDER_INTERVAL: u64 = 1000;
+
 /// Figures of the state after a step.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct StepReport {
@@ -361,6 +367,9 @@ impl Simulation {
 
     /// One step of length `dt`, then the host's work between steps.
     fn step_by(&mut self, dt: Real) {
+        if self.steps > 0 && self.steps % SPACE_ORDER_INTERVAL == 0 {
+            self.refresh_space_order();
+        }
         let before = self.world.time;
         self.backend.step(&mut self.world, dt);
         self.particles_behind = !self.backend.particles_on_host();
@@ -394,6 +403,19 @@ impl Simulation {
             self.update_fluid();
         }
         self.update_settling();
+    }
+
+    /// Places the owned particles in the space order anew, at the steps of its
+    /// schedule (so on every rank together, and after a restart as before it). A
+    /// rank codes its particles but keeps their places: it sends the states of
+    /// those that are ghosts elsewhere by their places until the next renewal of
+    /// the lists, which the change causes.
+    fn refresh_space_order(&mut self) {
+        self.sync_particles();
+        let reorders = self.backend.share().is_none();
+        if self.world.refresh_space_order(reorders) {
+            self.backend.particles_removed(&self.world);
+        }
     }
 
     /// Whether the host's work after the step that began at `before` reads or changes

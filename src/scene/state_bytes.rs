@@ -1,11 +1,12 @@
 //! The dynamic state of a [`crate::scene::Simulation`] ([`SimState`]) as bytes, and back.
 //!
 //! What is saved is everything that evolves: particles (with this step's forces, which
-//! the next half kick uses, and whether they are frozen), wall poses, velocities and
-//! forces, the tangential contact history, the positions and wall poses the
-//! candidate lists were last built from, inlet counters, box offsets and random
-//! generators, time, step count, the settling clock, the bed height last measured, and
-//! a coupled fluid's inputs, particle shares and exchange.
+//! the next half kick uses, whether they are frozen, and their cell in the space
+//! order), wall poses, velocities and forces, the tangential contact history, the
+//! positions and wall poses the candidate lists were last built from, inlet
+//! counters, box offsets and random generators, time, step count, the settling
+//! clock, the bed height last measured, and a coupled fluid's inputs, particle
+//! shares and exchange.
 //! What a scene defines once (materials, shapes, wall meshes and their facet grids) is
 //! not saved: a state is restored into a simulation of the same scene, and a
 //! fingerprint of that scene in the header refuses any other. Restoring and stepping
@@ -31,7 +32,8 @@ use crate::world::{CellShares, MomentumExchange, Particles};
 
 /// The header of a state; the digit is the format's version (4: states in checked
 /// containers; 5: the rolling spring in the contact history; 6: the fluid field; 7:
-/// the energy account; 8: what the candidate lists were last built from).
+/// the energy account; 8: what the candidate lists were last built from, and each
+/// particle's cell in the space order).
 pub const STATE_MAGIC: &[u8; 8] = b"TALUSST8";
 
 /// The header of version 7, still read: its lists are built from the restored world.
@@ -280,6 +282,7 @@ impl SimState {
             w.vec3(&p.force[i]);
             w.vec3(&p.torque[i]);
             w.u64(p.frozen[i] as u64);
+            w.u64(p.cell_code[i]);
         }
 
         w.u64(self.walls.len() as u64);
@@ -325,6 +328,7 @@ impl SimState {
     /// [`StateReader::is_done`] or reads on). Whether it fits the scene (body types,
     /// walls, facets, inlets) is checked when it is restored.
     pub fn read(fingerprint: u64, r: &mut StateReader) -> Result<SimState, StateError> {
+        // Version 8 adds each particle's cell code and the lists' anchors.
         let has_list = if r.magic(STATE_MAGIC) {
             true
         } else if r.magic(STATE_MAGIC_7) {
@@ -364,7 +368,7 @@ impl SimState {
             )));
         }
 
-        let n = r.count(8 * 22)?;
+        let n = r.count(8 * (22 + usize::from(has_list)))?;
         let mut particles = Particles::default();
         for _ in 0..n {
             let id = r.u64()?;
@@ -389,6 +393,9 @@ impl SimState {
                     )));
                 }
             };
+            if has_list {
+                particles.cell_code[i] = r.u64()?;
+            }
         }
 
         let mut walls = Vec::new();

@@ -153,7 +153,8 @@ impl FluidField {
 
     /// Splits every owned particle's volume among the cells again: the shares, the
     /// solid fractions and the mean particle velocities (each cell's sums in
-    /// particle order: the same bits on any thread count).
+    /// particle id order: the same bits on any thread count, any number of ranks
+    /// and whatever the order the particles are stored in).
     pub fn update(&mut self, particles: &Particles, types: &[BodyType]) {
         self.shares = CellShares::compute(&self.grid, particles, types);
         let contributions = self.contributions(particles);
@@ -161,10 +162,10 @@ impl FluidField {
     }
 
     /// What each owned particle with a row of the shares brings to each of its
-    /// cells, in particle order, then cell order.
+    /// cells, in particle id order, then cell order.
     pub fn contributions(&self, particles: &Particles) -> Vec<CellContribution> {
         let mut out = Vec::new();
-        for i in 0..particles.owned() {
+        for i in particles.owned_by_id() {
             let id = particles.id[i];
             let Some((cells, volumes)) = self.shares.of(i, id) else {
                 continue;
@@ -206,6 +207,18 @@ impl FluidField {
             i += 1;
             !removed.get(i - 1).copied().unwrap_or(false)
         });
+        self.shares = self.shares.keep(&particles.id[..particles.owned()], &[]);
+    }
+
+    /// Follows the owned particles into a new order (`places[k]`: the index before
+    /// of the particle now at `k`, see [`Particles::reorder_owned`]).
+    pub fn particles_reordered(&mut self, places: &[u32], particles: &Particles) {
+        let drag = &self.exchange.drag;
+        if !drag.is_empty() {
+            // Particles added since the last force evaluation have no drag yet.
+            let of = |k: &u32| drag.get(*k as usize).copied().unwrap_or_default();
+            self.exchange.drag = places.iter().map(of).collect();
+        }
         self.shares = self.shares.keep(&particles.id[..particles.owned()], &[]);
     }
 

@@ -7,6 +7,7 @@ mod fluid;
 mod inlet;
 mod motion;
 mod particles;
+mod space_order;
 mod walls;
 
 use std::ops::Range;
@@ -21,6 +22,7 @@ pub use fluid::{
 pub use inlet::{Inlet, Obstacle, PLACEMENT_ATTEMPTS, PlacedParticle, is_free, random_orientation};
 pub use motion::{DriveInput, MotionKey, WallMotion, WallVelocity, advance_pose};
 pub use particles::Particles;
+pub use space_order::SpaceOrder;
 
 /// The mass of a set of particles and its first moment `Σ m x`: the moment of
 /// their weight about any point (a sum, so the shares of ranks add up).

@@ -46,6 +46,11 @@ pub struct Particles {
     /// its velocity and angular momentum are zero, and only particles that are not
     /// frozen feel its contacts.
     pub frozen: Vec<bool>,
+    /// The code of the cell that held the particle at the last refresh of the space
+    /// order, [`Particles::NO_CELL`] for one made since (see
+    /// [`crate::world::SpaceOrder`]): with the id, the key by which its contacts
+    /// are summed and the owned particles stored. A ghost carries its owner's.
+    pub cell_code: Vec<u64>,
     /// Number of ghost copies at the end of the arrays.
     ghosts: usize,
     /// Entry of each id.
@@ -192,6 +197,7 @@ impl Particles {
         self.body_type.insert(at, body_type);
         self.id.insert(at, id);
         self.frozen.insert(at, false);
+        self.cell_code.insert(at, Self::NO_CELL);
         self.index.insert(id, at as u32);
     }
 
@@ -224,6 +230,7 @@ impl Particles {
         retain(&mut self.body_type, &keep);
         retain(&mut self.id, &keep);
         retain(&mut self.frozen, &keep);
+        retain(&mut self.cell_code, &keep);
         self.ghosts -= removed_ghosts;
         self.reindex();
         n - self.len()
@@ -239,6 +246,29 @@ impl Particles {
         self.body_type.truncate(n);
         self.id.truncate(n);
         self.frozen.truncate(n);
+        self.cell_code.truncate(n);
+    }
+
+    /// Stores the owned particles in a new order: entry `k` becomes the particle
+    /// that was at `places[k]`, for `places` a permutation of `0..owned()`. The
+    /// ghosts keep their places.
+    pub fn reorder_owned(&mut self, places: &[u32]) {
+        assert_eq!(places.len(), self.owned(), "one entry per owned particle");
+        fn apply<T: Copy>(v: &mut [T], places: &[u32]) {
+            let moved: Vec<T> = places.iter().map(|&k| v[k as usize]).collect();
+            v[..places.len()].copy_from_slice(&moved);
+        }
+        apply(&mut self.position, places);
+        apply(&mut self.orientation, places);
+        apply(&mut self.velocity, places);
+        apply(&mut self.angular_momentum, places);
+        apply(&mut self.force, places);
+        apply(&mut self.torque, places);
+        apply(&mut self.body_type, places);
+        apply(&mut self.id, places);
+        apply(&mut self.frozen, places);
+        apply(&mut self.cell_code, places);
+        self.reindex();
     }
 
     /// The owned particles alone (what a saved state holds).

@@ -14,6 +14,8 @@ use talus::world::World;
 /// Analyses `world`'s bed and writes the packing files (and the poses) into `dir`;
 /// prints the main figures.
 pub fn write_bed_files(scene: &Scene, bed: &Bed, world: &World, dir: &Path) -> Result<()> {
+    // Files list the particles by id, whatever the order they are stored in.
+    let world = &*world.in_id_order();
     write_poses(dir, world, &scene.shape_names)?;
     let shrink = scene.spec.bed.as_ref().map_or(1.0, |b| b.shrink);
     write_bed_stl(dir, world, shrink)?;

@@ -5,7 +5,7 @@
 //! closing kick: [`CpuBackend::step`] and [`CpuBackend::evaluate_forces`] list the
 //! stages in order, each a data-parallel loop over particles, pairs or particle
 //! chunks that writes its own slot, timed by [`StageTimes`]. Each particle gathers its
-//! pairs' forces in pair order (its partners in the order of their ids) and wall
+//! pairs' forces in pair order (its partners in the order of their space keys) and wall
 //! contacts are added in particle order, so the results do not depend on the number
 //! of threads, and the particles' motion not on their order in the arrays (the
 //! walls' totals do, by round-off; `tests/memory_order.rs`).

@@ -215,7 +215,13 @@ impl Backend for CudaBackend {
 
     /// Appended to the device's particles (an inlet's, after every other).
     fn particles_added(&mut self, world: &World, added: std::ops::Range<usize>) {
-        let appended = added.end == world.particles.len() && world.particles.id.is_sorted();
+        // The device keeps its particles in id order: new ones follow it where
+        // their ids ascend past every other (the host may store the others in the
+        // space order).
+        let id = &world.particles.id;
+        let appended = added.end == id.len()
+            && id[added.clone()].is_sorted()
+            && (id[..added.start].iter().max()).is_none_or(|&m| id.get(added.start) > Some(&m));
         match self.spheres.as_mut() {
             Some(spheres) if appended && spheres.particles() == added.start => {
                 spheres.append(world).unwrap_or_else(|e| fail(e));

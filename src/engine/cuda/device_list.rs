@@ -6,7 +6,8 @@
 //! # Invariant
 //! After a build, `pairs` holds every pair `(i, j)`, `i < j`, whose centres are
 //! closer than `r_i + r_j + skin`, sorted; `incident` lists for each particle the
-//! pairs that hold it, ascending; `keys` the ids of each pair's particles, and
+//! pairs that hold it in the order of its partners' space keys (cell code, then
+//! id: the CPU backend's order); `keys` the ids of each pair's particles, and
 //! `old_keys` those of the list before (for carrying the tangential history over).
 //! The list is rebuilt before any particle has moved half a skin since the build.
 
@@ -109,13 +110,14 @@ fn zero(device: &mut dyn Device, values: &Array<u32>, n: usize) -> Result<(), De
     unsafe { run(device, Kernel::ZeroWords, n, &[count(n), values.arg()]) }
 }
 
-/// What the list is built from: the particles' positions, body types and ids, and
-/// each body type's bounding radius.
+/// What the list is built from: the particles' positions, body types, ids and cell
+/// codes, and each body type's bounding radius.
 pub(super) struct ListInputs<'a> {
     pub n: usize,
     pub position: &'a Array<Real>,
     pub body_type: &'a Array<u32>,
     pub id: &'a Array<u64>,
+    pub cell_code: &'a Array<u64>,
     pub type_radius: &'a Array<Real>,
 }
 
@@ -311,7 +313,13 @@ impl DeviceList {
                 device,
                 Kernel::SortIncident,
                 n,
-                &[count(n), self.incident_starts.arg(), self.incident.arg()],
+                &[
+                    count(n),
+                    self.pairs.arg(),
+                    at.cell_code.arg(),
+                    self.incident_starts.arg(),
+                    self.incident.arg(),
+                ],
             )?;
             run(
                 device,

@@ -25,6 +25,8 @@ pub struct ParticleRecord {
     pub velocity: Vector3<Real>,
     /// Angular momentum (world frame).
     pub angular_momentum: Vector3<Real>,
+    /// Code of its cell in the space order (see [`crate::world::SpaceOrder`]).
+    pub cell_code: u64,
 }
 
 impl ParticleRecord {
@@ -38,6 +40,7 @@ impl ParticleRecord {
             orientation: p.orientation[i],
             velocity: p.velocity[i],
             angular_momentum: p.angular_momentum[i],
+            cell_code: p.cell_code[i],
         }
     }
 
@@ -48,20 +51,22 @@ impl ParticleRecord {
         self.set_state(p, i);
     }
 
-    /// Writes the motion state and the frozen flag (a ghost's may change between
-    /// steps, by the host's bed measurement) into entry `i`.
+    /// Writes the motion state, the frozen flag (a ghost's may change between
+    /// steps, by the host's bed measurement) and the cell code into entry `i`.
     pub(super) fn set_state(&self, p: &mut Particles, i: usize) {
         p.position[i] = self.position;
         p.orientation[i] = self.orientation;
         p.velocity[i] = self.velocity;
         p.angular_momentum[i] = self.angular_momentum;
         p.frozen[i] = self.frozen;
+        p.cell_code[i] = self.cell_code;
     }
 }
 
 impl Message for ParticleRecord {
     fn encode(&self, out: &mut Vec<u64>) {
         out.extend([self.id, u64::from(self.body_type), u64::from(self.frozen)]);
+        out.push(self.cell_code);
         self.position.encode(out);
         self.orientation.encode(out);
         self.velocity.encode(out);
@@ -72,6 +77,7 @@ impl Message for ParticleRecord {
             id: words.next_word(),
             body_type: words.next_word() as u32,
             frozen: words.next_word() != 0,
+            cell_code: words.next_word(),
             position: Point3::decode(words),
             orientation: UnitQuaternion::decode(words),
             velocity: Vector3::decode(words),

@@ -92,6 +92,9 @@ struct ParticleArrays {
     /// Frozen, a ghost, or both: nonzero where nobody here moves the particle.
     role: Array<u8>,
     id: Array<u64>,
+    /// Codes of the cells in the space order (each particle sums its pairs in the
+    /// order of its partners' codes, then ids).
+    cell_code: Array<u64>,
     touching: Array<u8>,
 }
 
@@ -312,6 +315,7 @@ impl DeviceSpheres {
         a.body_type.write(d, &in_order(&p.body_type, order))?;
         a.role.write(d, &roles(p, order))?;
         a.id.write(d, &in_order(&p.id, order))?;
+        a.cell_code.write(d, &in_order(&p.cell_code, order))?;
         a.touching.resize(d, p.len())?;
         self.list.invalidate();
         self.stale = None;
@@ -446,6 +450,7 @@ impl DeviceSpheres {
                 position: &p.position,
                 body_type: &p.body_type,
                 id: &p.id,
+                cell_code: &p.cell_code,
                 type_radius: &t.radius,
             };
             // The tangential history carried over by the pairs' ids: from this list,

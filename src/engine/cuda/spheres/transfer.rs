@@ -44,6 +44,7 @@ impl DeviceSpheres {
                 .map(|a| a.bytes(d))
                 .sum::<usize>()
             + p.id.bytes(d)
+            + p.cell_code.bytes(d)
             + self.list.bytes(d)
             + self.walls.bytes(d)
             + self.sums.bytes(d)
@@ -135,6 +136,7 @@ impl DeviceSpheres {
             roles(p, &r.collect::<Vec<_>>())
         })?;
         grow(d, &mut a.id, from, n, |r| p.id[r].to_vec())?;
+        grow(d, &mut a.cell_code, from, n, |r| p.cell_code[r].to_vec())?;
         a.touching.resize(d, n)?;
         self.walls.grow(d, n)?;
         self.n = n;
