@@ -320,8 +320,8 @@ fn world_of(like: &World, mut records: Vec<ParticleRecord>) -> World {
 
 /// The bed height one process measures, on ranks (collective): rank 0 measures
 /// the bed's particles near its top (`member`s of every rank whose top lies above
-/// where [`bed_height_of`] integrates from) in id order, as one process holds
-/// them, and every rank gets its answer. `None` when there is no bed yet.
+/// where [`bed_height_of`] integrates from), which it integrates in id order as
+/// one process does, and every rank gets its answer. `None` when there is no bed yet.
 pub(super) fn bed_height_on_ranks(
     share: &dyn Share,
     world: &World,

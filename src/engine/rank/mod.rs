@@ -10,9 +10,10 @@
 //! left the box move to their new owner with their contact history, and the ghosts
 //! are chosen again; then the forces (the lists rebuilt where renewed) and the
 //! closing kick. Ghosts are copied bit for bit, each pair is evaluated the same way
-//! round on every rank that holds it (the neighbour lists orient and sort pairs by
-//! particle id), and each particle gathers its pairs in id order, so an owned
-//! particle's force is the one-process force to the bit.
+//! round on every rank that holds it (the neighbour lists orient pairs by particle
+//! id and sort them by the particles' space keys, which ghosts carry from their
+//! owners), and each particle gathers its pairs in its partners' key order, so an
+//! owned particle's force is the one-process force to the bit.
 //!
 //! **History.** A pair's tangential history lives on every rank that holds the
 //! pair with one of its particles owned there, computed identically on each; at a
