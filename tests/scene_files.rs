@@ -340,3 +340,45 @@ fn inlets_insert_at_their_rate_without_overlap() {
     }
     assert_eq!(checked, 39);
 }
+
+/// Shape tables that say the same share one template (what the pair stage reads
+/// from the caches); tables that differ in any number do not, and each (shape table,
+/// material) is still a body type of its own.
+#[test]
+fn shape_tables_that_say_the_same_share_a_template() {
+    let rock = |name: &str, seed: u64| {
+        format!(
+            "[shapes.{name}]\nkind = \"random_convex\"\npoints = 14\nradius = 0.005\n\
+             jitter = 0.3\nseed = {seed}\n"
+        )
+    };
+    let group = |shape: &str, x: f64| {
+        format!(
+            "[[particles]]\nkind = \"list\"\nshape = \"{shape}\"\nmaterial = \"steel\"\n\
+             bodies = [{{ position = [{x}, 0, 0] }}]\n"
+        )
+    };
+    let text = [
+        rock("a", 7),
+        rock("b", 7),
+        rock("c", 8),
+        "[shapes.cube2]\nkind = \"cuboid\"\nsize = [0.01, 0.01, 0.01]\n".into(),
+        group("a", 0.0),
+        group("b", 0.02),
+        group("c", 0.04),
+        group("cube", 0.06),
+        group("cube2", 0.08),
+    ]
+    .concat();
+    let scene = parse(&text).unwrap();
+    let w = &scene.world;
+    let template = |k: usize| {
+        let t = &w.body_types[w.particles.body_type[k] as usize];
+        std::ptr::from_ref(t.shape.as_polyhedron().unwrap())
+    };
+    assert_eq!(w.body_types.len(), 5, "a body type per shape table");
+    assert_eq!(template(0), template(1), "a and b say the same");
+    assert_ne!(template(0), template(2), "c has another seed");
+    assert_eq!(template(3), template(4), "cube and cube2 say the same");
+    assert_ne!(template(0), template(3));
+}

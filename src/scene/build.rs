@@ -1,7 +1,7 @@
 //! From the scene as written to a validated [`Scene`]: materials, shapes, body types,
 //! walls, particles and inlets, each problem reported with its field.
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, HashMap};
 use std::path::Path;
 
 use nalgebra::{Point3, UnitQuaternion, Vector3};
@@ -202,11 +202,23 @@ impl<'a> Builder<'a> {
         Ok(())
     }
 
+    /// Builds each shape table; tables that say the same (a generated scene that
+    /// names one shape per particle group, say) share one template, so that the
+    /// pair stage reads it from the caches and the time step and the laws' rows see
+    /// it once. A spec is known by its `Debug` text, in which a number reads back as
+    /// the same bits.
     fn shapes(&mut self) -> Result<()> {
+        let mut built: HashMap<String, usize> = HashMap::new();
         for (name, spec) in &self.spec.shapes {
+            let key = format!("{spec:?}");
+            if let Some(&s) = built.get(&key) {
+                self.shapes.push(self.shapes[s].clone());
+                continue;
+            }
             let shape = spec
                 .build(self.dir)
                 .map_err(|e| FieldError::new(FieldPath::root("shapes").key(name), e.to_string()))?;
+            built.insert(key, self.shapes.len());
             self.shapes.push(shape);
         }
         Ok(())

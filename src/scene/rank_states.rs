@@ -1,8 +1,8 @@
 //! Saved states of a run on ranks: the whole run's state gathered on rank 0, the
 //! state one process saves but for the particles' order (here by id; one process
 //! saves them as it stores them, in the space order), with the contact history
-//! sorted by key, so that a state saved by N ranks restores on M ranks or in one process,
-//! and one saved by one process restores on ranks.
+//! sorted by key, so that a state saved by N ranks restores on M ranks or in one
+//! process, and one saved by one process restores on ranks.
 
 use std::fmt;
 

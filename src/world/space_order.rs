@@ -134,8 +134,14 @@ impl Particles {
     /// The owned particles' entries in the order of their ids: the order in which
     /// outputs list them, whatever the order they are stored in.
     pub fn owned_by_id(&self) -> Vec<usize> {
-        let mut entries: Vec<usize> = (0..self.owned()).collect();
-        if !self.id[..self.owned()].is_sorted() {
+        self.by_id((0..self.owned()).collect())
+    }
+
+    /// `entries` (distinct entries of these particles) sorted by their particles'
+    /// ids; left as they are where they already are, as after a run on one process
+    /// that never stored its particles in the space order.
+    pub fn by_id(&self, mut entries: Vec<usize>) -> Vec<usize> {
+        if !entries.is_sorted_by_key(|&i| self.id[i]) {
             entries.sort_unstable_by_key(|&i| self.id[i]);
         }
         entries

@@ -228,8 +228,8 @@ impl<'a> Placed<'a> {
         let frame = tube.frame();
         // By id: the same sums whatever the order the particles are stored in (one
         // process stores them in the space order, ranks gather them by id).
-        let mut kept: Vec<usize> = (0..world.particles.len()).filter(|&i| keep(i)).collect();
-        kept.sort_unstable_by_key(|&i| world.particles.id[i]);
+        let p = &world.particles;
+        let kept = p.by_id((0..p.len()).filter(|&i| keep(i)).collect());
         // Per body type once: a polyhedron's surface sums its faces.
         let ratio: Vec<Real> = world
             .body_types

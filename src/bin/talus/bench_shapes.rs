@@ -3,8 +3,9 @@
 //! A dense lattice of random convex polyhedra three times:
 //! - 20 shapes, each particle naming one of them;
 //! - the same particles, each with its own shape table (a body type per particle)
-//!   built from the same 20 seeds: the same contacts, only the number of body types
-//!   differs, so the ratio of the two is what a body type costs;
+//!   of the same 20 seeds, which share the 20 templates (tables that say the same
+//!   do): the same contacts, only the number of body types differs, so the ratio
+//!   of the two is what a body type costs;
 //! - every particle its own random shape (as from scanned rocks): other contacts,
 //!   and every contact reads two shapes no other contact shares, which the caches
 //!   feel.

@@ -23,6 +23,7 @@ mod fluid;
 mod forces;
 mod fused;
 mod hertz;
+mod huge_pages;
 mod keep_awake;
 pub(crate) mod motion;
 mod overlap_plans;

@@ -13,6 +13,7 @@
 use std::collections::HashSet;
 use std::ops::Range;
 
+use super::huge_pages::back_with_huge_pages;
 use crate::Real;
 use crate::geometry::Shape;
 use crate::world::World;
@@ -63,6 +64,9 @@ impl TypeTable {
             .flat_map(|r| r.contact_memory.iter().map(ExactSizeIterator::len))
             .sum();
         self.fetch_shapes = bytes > CACHED_SHAPE_BYTES;
+        if self.fetch_shapes {
+            back_with_huge_pages(self.rows.iter().flat_map(|r| r.contact_memory.clone()));
+        }
     }
 
     /// Whether a contact's shapes are worth fetching ahead: they do not all stay in

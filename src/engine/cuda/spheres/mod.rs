@@ -158,11 +158,7 @@ fn quaternions(q: &[UnitQuaternion<Real>]) -> Vec<Real> {
 
 /// The host world's entries in the order of their ids.
 fn id_order(p: &Particles) -> Vec<usize> {
-    let mut order: Vec<usize> = (0..p.len()).collect();
-    if !p.id.is_sorted() {
-        order.sort_unstable_by_key(|&i| p.id[i]);
-    }
-    order
+    p.by_id((0..p.len()).collect())
 }
 
 /// `values` of the host entries `order`.
