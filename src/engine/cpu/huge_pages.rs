@@ -51,7 +51,8 @@ pub(super) fn back_with_huge_pages(ranges: impl Iterator<Item = Range<usize>>) -
 fn advise(span: Range<usize>) -> bool {
     let at = std::ptr::without_provenance_mut::<libc::c_void>(span.start);
     // SAFETY: madvise with these advices changes how memory is backed, never what
-    // it holds; on addresses not mapped it fails (ENOMEM) and touches nothing.
+    // it holds (whatever mapping the span's edges reach into); where part of the
+    // span is not mapped it advises the mapped parts and reports ENOMEM.
     unsafe {
         libc::madvise(at, span.len(), libc::MADV_HUGEPAGE);
         libc::madvise(at, span.len(), libc::MADV_COLLAPSE) == 0
