@@ -555,9 +555,8 @@ fn many_shapes(dir: &Path, options: &BenchOptions) -> Result<()> {
         let text = crate::bench_shapes::many_shapes(side, types, seeds, MATERIAL);
         let setup = crate::bench_shapes::setup(&text, dir)?;
         let seconds = setup.check + setup.first_step;
-        // Per thousand types for the variants of a type per particle (the base's
-        // 20 types make no thousands).
-        let per_thousand = if types > 20 {
+        // Per thousand types for the variants of a type per particle.
+        let per_thousand = if types == count {
             format!(
                 ", {:.3} s per thousand body types",
                 seconds / (types as f64 / 1000.0)

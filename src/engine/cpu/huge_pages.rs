@@ -14,55 +14,40 @@ use std::ops::Range;
 /// The size of a huge page on x86_64 and aarch64 with 4 KB base pages.
 const HUGE_PAGE: usize = 2 << 20;
 
-/// What was asked of the kernel.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub(super) struct HugePages {
-    /// Huge pages asked for.
-    pub asked: usize,
-    /// Of them, those in runs the kernel merged whole (a run whose last page
-    /// reaches past the mapped heap is merged but for that page, and not counted).
-    pub collapsed: usize,
-}
-
 /// Asks for the huge pages that hold `ranges` (addresses of live heap data) to be
-/// backed as such. The pages are taken in runs of neighbours, so that data spread
-/// over heaps far apart (one per thread) asks for nothing between them.
-pub(super) fn back_with_huge_pages(ranges: impl Iterator<Item = Range<usize>>) -> HugePages {
+/// backed as such; returns how many were asked for. The pages are taken in runs of
+/// neighbours, so that data spread over heaps far apart (one per thread) asks for
+/// nothing between them.
+pub(super) fn back_with_huge_pages(ranges: impl Iterator<Item = Range<usize>>) -> usize {
     let mut pages: Vec<usize> = ranges
         .filter(|r| !r.is_empty())
         .flat_map(|r| r.start / HUGE_PAGE..=(r.end - 1) / HUGE_PAGE)
         .collect();
     pages.sort_unstable();
     pages.dedup();
-    let mut done = HugePages::default();
     for run in pages.chunk_by(|a, b| b - a == 1) {
-        let span = run[0] * HUGE_PAGE..(run[run.len() - 1] + 1) * HUGE_PAGE;
-        done.asked += run.len();
-        if advise(span) {
-            done.collapsed += run.len();
-        }
+        advise(run[0] * HUGE_PAGE..(run[run.len() - 1] + 1) * HUGE_PAGE);
     }
-    done
+    pages.len()
 }
 
 /// Asks for `span` (whole huge pages) to be backed by huge pages, and to be merged
-/// now; whether it was.
+/// now.
 #[cfg(target_os = "linux")]
-fn advise(span: Range<usize>) -> bool {
+fn advise(span: Range<usize>) {
     let at = std::ptr::without_provenance_mut::<libc::c_void>(span.start);
     // SAFETY: madvise with these advices changes how memory is backed, never what
     // it holds (whatever mapping the span's edges reach into); where part of the
-    // span is not mapped it advises the mapped parts and reports ENOMEM.
+    // span is not mapped it advises the mapped parts and reports ENOMEM, which,
+    // like a kernel that declines, changes nothing but the speed.
     unsafe {
         libc::madvise(at, span.len(), libc::MADV_HUGEPAGE);
-        libc::madvise(at, span.len(), libc::MADV_COLLAPSE) == 0
+        libc::madvise(at, span.len(), libc::MADV_COLLAPSE);
     }
 }
 
 #[cfg(not(target_os = "linux"))]
-fn advise(_span: Range<usize>) -> bool {
-    false
-}
+fn advise(_span: Range<usize>) {}
 
 #[cfg(all(test, target_os = "linux"))]
 mod tests {
@@ -95,9 +80,9 @@ mod tests {
             .is_ok_and(|mode| !mode.contains("[never]"));
         let data: Vec<u64> = (0..1u64 << 20).collect();
         let at = data.as_ptr().addr();
-        let done = back_with_huge_pages(std::iter::once(at..at + (8 << 20)));
+        let asked = back_with_huge_pages(std::iter::once(at..at + (8 << 20)));
         assert!(
-            (4..=5).contains(&done.asked),
+            (4..=5).contains(&asked),
             "8 MB lie in four or five 2 MB pages"
         );
         if offered {
