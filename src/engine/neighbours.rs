@@ -96,6 +96,8 @@ pub struct NeighbourList {
     /// facets of wall `w` near particle `k`, ascending.
     facet_starts: Vec<u32>,
     facets: Vec<u32>,
+    /// The particles with a facet of some wall in their lists, ascending.
+    near_walls: Vec<u32>,
     /// What the lists were built from: particle ids and positions, positions in every
     /// wall's frame (particle-major), and each wall's facet count and pose.
     ids: Vec<u64>,
@@ -164,6 +166,13 @@ impl NeighbourList {
     pub fn facets(&self, k: usize, w: usize) -> &[u32] {
         let slot = k * self.wall_facets.len() + w;
         &self.facets[self.facet_starts[slot] as usize..self.facet_starts[slot + 1] as usize]
+    }
+
+    /// The particles with a facet of some wall in their lists, ascending: the only
+    /// ones that may touch a wall (in a bed a wall's neighbours are a few of its
+    /// particles, and the wall stage visits these alone).
+    pub fn near_walls(&self) -> &[u32] {
+        &self.near_walls
     }
 
     /// The ids of the two particles of a listed pair (as they were at the build).
@@ -246,6 +255,16 @@ impl NeighbourList {
         for list in lists {
             self.facets.extend_from_slice(&list);
             self.facet_starts.push(self.facets.len() as u32);
+        }
+        self.near_walls.clear();
+        if walls > 0 {
+            let starts = self.facet_starts.chunks_exact(walls);
+            let ends = self.facet_starts[1..].chunks_exact(walls);
+            (self.near_walls).extend(
+                (starts.zip(ends).enumerate())
+                    .filter(|(_, (s, e))| s[0] != e[walls - 1])
+                    .map(|(k, _)| k as u32),
+            );
         }
         self.valid = true;
         self.builds += 1;
@@ -522,6 +541,50 @@ mod tests {
         other.resume_from(anchors);
         other.build(&world, &radii);
         assert_eq!(other.pairs(), moved_pairs(&world, &radii));
+    }
+
+    /// The particles near walls are exactly those with a listed facet of some wall,
+    /// ascending: two planes (the floor and a side) under random spheres, some near
+    /// one, some near both, most near neither.
+    #[test]
+    fn particles_near_walls_are_those_with_listed_facets() {
+        use crate::geometry::surfaces;
+        use crate::world::Wall;
+        let mut world = random_spheres();
+        for (centre, normal) in [
+            (Point3::new(0.1, 0.1, 0.0), nalgebra::Vector3::z()),
+            (Point3::new(0.0, 0.1, 0.1), nalgebra::Vector3::x()),
+        ] {
+            let s = surfaces::plane(centre, normal, 0.2).unwrap();
+            world
+                .walls
+                .push(Wall::new("plane", 0, s.vertices, s.triangles, 0.02));
+        }
+        let radii = vec![0.01; 300];
+        let mut list = NeighbourList {
+            skin: Some(0.002),
+            ..Default::default()
+        };
+        list.build(&world, &radii);
+        let near = |k: usize, w: usize| !list.facets(k, w).is_empty();
+        let expected: Vec<u32> = (0..300)
+            .filter(|&k| near(k, 0) || near(k, 1))
+            .map(|k| k as u32)
+            .collect();
+        assert_eq!(list.near_walls(), expected);
+        let both = (0..300).filter(|&k| near(k, 0) && near(k, 1)).count();
+        assert!(
+            expected.len() > 20 && expected.len() < 150 && both > 0,
+            "{} near, {both} near both",
+            expected.len()
+        );
+        // Every particle within reach plus skin of the floor is near it (the grid may
+        // list a few more: it finds facets by cells of 0.02).
+        for k in 0..300 {
+            let z = world.particles.position[k].z;
+            assert!(near(k, 0) || z >= 0.012, "particle {k} at z = {z}");
+            assert!(!near(k, 0) || z < 0.012 + 0.04, "particle {k} at z = {z}");
+        }
     }
 
     /// The pairs of lists built from `world` as it is.

@@ -20,7 +20,8 @@ pub(super) type WallEntry = (WallKey, TangentialHistory);
 /// # Invariant
 /// Where `aligned`, `entries[starts[k]..starts[k + 1]]` are the patches of the
 /// particle at index `k`, whose id is `ids[k]` (every one of their keys starts with
-/// it), each with a history that is not empty, and `starts.len() == ids.len() + 1`.
+/// it), each with a history that is not empty, `starts.len() == ids.len() + 1`, and
+/// `holders` lists the indices whose groups are not empty, ascending.
 /// Otherwise (a history set from outside) the groups are not made yet and `entries`
 /// holds the patches in any order. `orphans` are patches of particles that were not in
 /// the world when the groups were last made: they end at the next step.
@@ -30,6 +31,7 @@ pub(super) struct WallHistory {
     ids: Vec<u64>,
     starts: Vec<u32>,
     entries: Vec<WallEntry>,
+    holders: Vec<u32>,
     orphans: Vec<WallEntry>,
     /// Where the groups are made anew (kept to allocate nothing once grown).
     sorted: Vec<WallEntry>,
@@ -71,9 +73,13 @@ impl WallHistory {
         let mut taken = vec![false; self.sorted.len()];
         self.starts.clear();
         self.starts.push(0);
-        for &id in ids {
+        self.holders.clear();
+        for (k, &id) in ids.iter().enumerate() {
             let first = self.sorted.partition_point(|e| e.0.0 < id);
             let end = first + self.sorted[first..].partition_point(|e| e.0.0 == id);
+            if end > first {
+                self.holders.push(k as u32);
+            }
             self.entries.extend_from_slice(&self.sorted[first..end]);
             taken[first..end].iter_mut().for_each(|t| *t = true);
             self.starts.push(self.entries.len() as u32);
@@ -92,6 +98,14 @@ impl WallHistory {
         &self.entries[self.starts[k] as usize..self.starts[k + 1] as usize]
     }
 
+    /// The indices of the particles that hold patches, ascending (the history must be
+    /// aligned).
+    #[inline]
+    pub(super) fn holders(&self) -> &[u32] {
+        debug_assert!(self.aligned);
+        &self.holders
+    }
+
     /// The patches of particles no longer in the world.
     pub(super) fn orphans(&self) -> &[WallEntry] {
         &self.orphans
@@ -105,6 +119,7 @@ impl WallHistory {
         self.starts.clear();
         self.starts.push(0);
         self.entries.clear();
+        self.holders.clear();
         self.orphans.clear();
     }
 
@@ -113,6 +128,9 @@ impl WallHistory {
     pub(super) fn push(&mut self, k: usize, entry: WallEntry) {
         debug_assert!(self.starts.len() <= k + 1 && entry.0.0 == self.ids[k]);
         let end = self.entries.len() as u32;
+        if self.holders.last() != Some(&(k as u32)) {
+            self.holders.push(k as u32);
+        }
         self.starts.resize(k + 1, end);
         self.entries.push(entry);
     }
@@ -148,6 +166,7 @@ mod tests {
         assert_eq!(h.of_particle(0), &[entry(7, 0, 1), entry(7, 1, 1)]);
         assert!(h.of_particle(1).is_empty());
         assert_eq!(h.of_particle(2), &[entry(9, 0, 5)]);
+        assert_eq!(h.holders(), &[0, 2]);
         assert!(h.orphans().is_empty());
     }
 
@@ -167,6 +186,7 @@ mod tests {
         assert_eq!(h.of_particle(0), &[entry(9, 0, 5)]);
         assert_eq!(h.of_particle(1), &[entry(7, 0, 1)]);
         assert!(h.of_particle(2).is_empty());
+        assert_eq!(h.holders(), &[0, 1]);
         assert_eq!(h.orphans(), &[entry(3, 0, 2)]);
         assert_eq!(h.to_sorted(), all);
 
@@ -175,6 +195,7 @@ mod tests {
         assert_eq!(h.of_particle(0), &[entry(9, 0, 5)]);
         assert!(h.of_particle(1).is_empty());
         assert_eq!(h.of_particle(2), &[entry(4, 2, 0)]);
+        assert_eq!(h.holders(), &[0, 2]);
         assert!(h.orphans().is_empty());
     }
 }

@@ -28,13 +28,13 @@ use crate::engine::neighbours::NeighbourList;
 use crate::geometry::Shape;
 use crate::world::{Wall, World};
 
-/// Particles per chunk of the wall stage. The particles touching a wall are bunched
-/// (a bed sorted by height has its whole floor layer first), so chunks are small
-/// enough for two threads to share the floor; a particle's wall contacts can cost as
-/// much as a hundred kick–drifts (a pellet against the facets of a tube).
-const PARTICLES_PER_CHUNK: usize = 64;
+/// Particles near walls per chunk of the wall stage. Only the particles with listed
+/// facets (or a patch to let go) are visited, and a particle's wall contacts can
+/// cost as much as a hundred kick–drifts (a pellet against the facets of a tube), so
+/// chunks are small enough for two threads to share them evenly.
+const PARTICLES_PER_CHUNK: usize = 32;
 
-/// How many particles ahead the shape of a particle near a wall is fetched: where
+/// How many visited particles ahead the shape of a particle near a wall is fetched: where
 /// each particle has a shape of its own, the first read of each shape went to
 /// memory (scene (d) of `talus bench`: the support query's scan of the vertices, 2 %
 /// of a step), and a particle's facet contacts take long enough to cover a fetch.
@@ -117,6 +117,9 @@ pub(super) struct WallWork {
     next_history: WallHistory,
     /// The contacts that ended this step, with their friction springs' energy.
     ended: Vec<(WallKey, Real)>,
+    /// The particles the stage visits, ascending: those near walls and those that
+    /// hold patches of the step before.
+    visit: Vec<u32>,
 }
 
 /// Evaluates and applies the wall contacts: particle forces and torques, wall forces,
@@ -138,8 +141,11 @@ pub(super) fn wall_contacts(
             .iter_mut()
             .for_each(|f| *f = Vector3::zeros());
     }
-    let n = world.particles.len();
-    let chunks = n.div_ceil(PARTICLES_PER_CHUNK);
+    // Aligned at the list's builds: the world's ids do not change without one.
+    debug_assert!(history.is_aligned_to(&world.particles.id));
+    union_ascending(inputs.list.near_walls(), history.holders(), &mut work.visit);
+    let visit = &work.visit[..];
+    let chunks = visit.len().div_ceil(PARTICLES_PER_CHUNK);
     if work.chunks.len() < chunks {
         work.chunks.resize_with(chunks, WallChunk::default);
     }
@@ -148,8 +154,6 @@ pub(super) fn wall_contacts(
     for (placed, wall) in work.placed.iter_mut().zip(&world.walls) {
         placed.update(wall);
     }
-    // Aligned at the list's builds: the world's ids do not change without one.
-    debug_assert!(history.is_aligned_to(&world.particles.id));
     let w = &*world;
     let kept = &*history;
     let placed = &work.placed;
@@ -161,11 +165,13 @@ pub(super) fn wall_contacts(
             chunk.shares.clear();
             chunk.ended.clear();
             let start = c * PARTICLES_PER_CHUNK;
-            for i in start..(start + PARTICLES_PER_CHUNK).min(n) {
-                let ahead = i + SHAPE_AHEAD;
-                if inputs.types.fetch_shapes() && ahead < n && near_walls(w, &inputs, ahead) {
-                    fetch_shape(inputs.types, w.particles.body_type[ahead]);
+            for v in start..(start + PARTICLES_PER_CHUNK).min(visit.len()) {
+                if let Some(&ahead) = visit.get(v + SHAPE_AHEAD)
+                    && inputs.types.fetch_shapes()
+                {
+                    fetch_shape(inputs.types, w.particles.body_type[ahead as usize]);
                 }
+                let i = visit[v] as usize;
                 let (first, before) = (chunk.contacts.len(), kept.of_particle(i));
                 if !w.particles.is_passive(i) {
                     particle_contacts(w, i, &inputs, placed, before, chunk);
@@ -218,6 +224,21 @@ pub(super) fn wall_contacts(
     totals.dissipated += work.ended.iter().map(|e| e.1).sum::<Real>();
     std::mem::swap(history, next);
     totals
+}
+
+/// Sets `union` to the elements of `a` and `b` (each ascending, without repeats),
+/// ascending, each once.
+fn union_ascending(a: &[u32], b: &[u32], union: &mut Vec<u32>) {
+    union.clear();
+    let (mut i, mut j) = (0, 0);
+    while i < a.len() && j < b.len() {
+        let (x, y) = (a[i], b[j]);
+        union.push(x.min(y));
+        i += usize::from(x <= y);
+        j += usize::from(y <= x);
+    }
+    union.extend_from_slice(&a[i..]);
+    union.extend_from_slice(&b[j..]);
 }
 
 /// Whether particle `i` has facets of some wall in its list.
