@@ -3,6 +3,7 @@
 //! only change the cost.
 
 use super::overlap_plans::OverlapPlans;
+use super::pair_results::BLOCK;
 use super::wall_history::WallHistory;
 use crate::Real;
 use crate::contact::TangentialHistory;
@@ -17,11 +18,18 @@ use crate::world::World;
 /// `pair_history[k]` and `overlap_plans[k]` belong to `list.pairs()[k]` of the list
 /// last built, unless `pending` holds a history set from outside, which is matched to
 /// the pairs (by particle ids) at the next build and until then is the history.
+/// Where `overlap_plans` is empty, bit `k % BLOCK` of `held[k / BLOCK]` is set where
+/// `pair_history[k]` is not empty (with plans every pair is evaluated, the mask is
+/// not read, and it is made anew at the next build).
 /// `overlap_plans` is empty when the world had no polyhedra at that build.
 #[derive(Clone, Debug, Default)]
 pub(super) struct ContactState {
     /// Tangential history of each candidate pair.
     pub pair_history: Vec<TangentialHistory>,
+    /// Per block of [`BLOCK`] pairs, which hold a history: the pair stage of spheres
+    /// finds the pairs with something to do without reading the histories of those
+    /// apart.
+    pub held: Vec<u64>,
     /// What each candidate pair's exact overlap decided at some pose: it changes the
     /// cost, never the answer (see [`crate::geometry::overlap::OverlapCache`]), so it
     /// is neither saved nor carried over a list build.
@@ -83,5 +91,12 @@ impl ContactState {
                 .copied()
                 .unwrap_or_default()
         }));
+        self.held.clear();
+        (self.held).extend(self.pair_history.chunks(BLOCK).map(held_mask));
     }
+}
+
+/// The mask of the pairs of a block (at most [`BLOCK`]) whose `history` is not empty.
+pub(super) fn held_mask(history: &[TangentialHistory]) -> u64 {
+    (history.iter().enumerate()).fold(0, |mask, (k, h)| mask | u64::from(!h.is_empty()) << k)
 }

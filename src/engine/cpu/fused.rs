@@ -74,11 +74,12 @@ pub(super) fn pair_contacts_gathered(
         });
         let block_pairs = &pairs[block.clone()];
         let history = &mut state.pair_history[block];
+        let held = &mut state.held[first / BLOCK];
         evaluate_block(
             world,
             radii,
             &laws,
-            (block_pairs, history),
+            (block_pairs, history, held),
             plans,
             &mut spare,
             |k, c| {

@@ -4,7 +4,7 @@
 use nalgebra::Vector3;
 use rayon::prelude::*;
 
-use super::contact_state::ContactState;
+use super::contact_state::{ContactState, held_mask};
 use super::dispatch::pair_geometry;
 use super::forces::{ContactForce, PairResult, RelativeMotion, pair_force};
 use super::hertz::{HertzInputs, rolling_inertia, round_contact_force, round_radius, sphere_pair};
@@ -156,7 +156,7 @@ pub(super) fn pair_contacts(
     let pairs = list.pairs();
     let block = |b: usize,
                  (results, mask): (&mut [PairResult], &mut u64),
-                 history: &mut [TangentialHistory],
+                 (history, held): BlockHistory,
                  plans: Option<(&mut [OverlapCache], PairPrefetch)>,
                  spare: &mut OverlapCache| {
         let first = b * BLOCK;
@@ -170,7 +170,7 @@ pub(super) fn pair_contacts(
             world,
             radii,
             &laws,
-            (pairs, history),
+            (pairs, history, held),
             plans,
             spare,
             |k, c| {
@@ -179,13 +179,13 @@ pub(super) fn pair_contacts(
         );
     };
     let with_plans = state.overlap_plans.len() == pairs.len();
-    let history = &mut state.pair_history;
+    let (history, held) = (&mut state.pair_history, &mut state.held);
     if with_plans {
         let (plans, keeps_contact) = state.overlap_plans.split();
         let body_type = &world.particles.body_type;
         // The prefetch keeps where the histories lie; nothing is read through it.
         let prefetch = PairPrefetch::new((plans, keeps_contact), history, pairs, body_type, types);
-        result_blocks(results, history, pairs.len())
+        result_blocks(results, (history, held), pairs.len())
             .zip(plans.par_chunks_mut(BLOCK))
             .for_each_init(
                 OverlapCache::default,
@@ -195,32 +195,34 @@ pub(super) fn pair_contacts(
             );
     } else {
         // A world of spheres keeps no overlap plans (see `ContactState::rebuild`).
-        result_blocks(results, history, pairs.len())
+        result_blocks(results, (history, held), pairs.len())
             .for_each_init(OverlapCache::default, |spare, (b, (results, history))| {
                 block(b, results, history, None, spare)
             });
     }
 }
 
+/// A block's pairs' histories, and the mask of those that hold one (see
+/// [`ContactState`]'s invariant).
+type BlockHistory<'a> = (&'a mut [TangentialHistory], &'a mut u64);
+
 /// A block of the pair stage: its number, its results with their mask, and its
 /// pairs' histories.
 type ResultBlock<'a> = (
     usize,
-    (
-        (&'a mut [PairResult], &'a mut u64),
-        &'a mut [TangentialHistory],
-    ),
+    ((&'a mut [PairResult], &'a mut u64), BlockHistory<'a>),
 );
 
-/// The blocks of `pairs` pairs' results (each with its mask) and histories, numbered.
+/// The blocks of `pairs` pairs' results (each with its mask) and histories (each
+/// with the mask of those held), numbered.
 fn result_blocks<'a>(
     results: &'a mut PairResults,
-    history: &'a mut [TangentialHistory],
+    (history, held): (&'a mut [TangentialHistory], &'a mut [u64]),
     pairs: usize,
 ) -> impl IndexedParallelIterator<Item = ResultBlock<'a>> {
     results
         .blocks_mut(pairs)
-        .zip(history.par_chunks_mut(BLOCK))
+        .zip(history.par_chunks_mut(BLOCK).zip(held.par_iter_mut()))
         .enumerate()
 }
 
@@ -241,15 +243,21 @@ pub(super) fn evaluate_block(
     world: &World,
     radii: &[Real],
     laws: &PairLaws,
-    (pairs, history): (&[[u32; 2]], &mut [TangentialHistory]),
+    (pairs, history, held): (&[[u32; 2]], &mut [TangentialHistory], &mut u64),
     mut plans: Option<BlockPlans>,
     spare: &mut OverlapCache,
     mut take: impl FnMut(usize, PairResult),
 ) -> u64 {
     let p = &world.particles;
-    let mask = to_evaluate(plans.is_none(), p, radii, pairs, history);
-    // The pairs whose plan was read (near), and of them those that keep a contact.
-    let (mut read, mut kept) = (0u64, 0u64);
+    let sift = plans.is_none();
+    debug_assert!(
+        !sift || *held == held_mask(history),
+        "the held mask is the histories'"
+    );
+    let mask = to_evaluate(sift, p, radii, pairs, *held);
+    // The pairs whose plan was read (near), and of them those that keep a contact;
+    // the pairs that hold a history after (a pair left out kept its empty one).
+    let (mut read, mut kept, mut holds) = (0u64, 0u64, 0u64);
     for k in BusyBits(mask) {
         let plan = match &mut plans {
             Some(p) => {
@@ -265,6 +273,12 @@ pub(super) fn evaluate_block(
         );
         read |= u64::from(near) << k;
         kept |= u64::from(near && plan.keeps_contact()) << k;
+        if sift {
+            holds |= u64::from(!history[k].is_empty()) << k;
+        }
+    }
+    if sift {
+        *held = holds;
     }
     if let Some(p) = &plans {
         record(p.prefetch.keeps_contact_word(p.first), read, kept);
@@ -272,45 +286,36 @@ pub(super) fn evaluate_block(
     mask
 }
 
-/// The mask of the pairs of a block to evaluate (at most [`BLOCK`], with their
-/// `history`): the busy ones ([`busy_pairs`]) if `sift`, else all of them (an
-/// evaluation of a pair with nothing to do leaves it as it was). Sifting pays where
-/// the pairs are spheres; among polyhedra, whose overlap plans the callers pass,
-/// most candidates' bounding spheres overlap, the branch is foreseen, and sifting
-/// first cost about 4 % of the dense bed of `talus bench` (a) on one thread.
+/// The mask of the pairs of a block to evaluate (at most [`BLOCK`]; `held`: those
+/// holding a history): the busy ones ([`busy_pairs`]) if `sift`, else all of them
+/// (an evaluation of a pair with nothing to do leaves it as it was). Sifting pays
+/// where the pairs are spheres; among polyhedra, whose overlap plans the callers
+/// pass, most candidates' bounding spheres overlap, the branch is foreseen, and
+/// sifting first cost about 4 % of the dense bed of `talus bench` (a) on one thread.
 #[inline]
-fn to_evaluate(
-    sift: bool,
-    p: &Particles,
-    radii: &[Real],
-    pairs: &[[u32; 2]],
-    history: &[TangentialHistory],
-) -> u64 {
+fn to_evaluate(sift: bool, p: &Particles, radii: &[Real], pairs: &[[u32; 2]], held: u64) -> u64 {
     if sift {
-        busy_pairs(p, radii, pairs, history)
+        busy_pairs(p, radii, pairs, held)
     } else {
         u64::MAX >> (BLOCK - pairs.len())
     }
 }
 
-/// The mask of the pairs of a block (at most [`BLOCK`], with their `history`) that
-/// have something to do: they are [`near`], or their contact held a history that
-/// parting lets go. Found without a branch per pair: whether a pair touches is as
-/// good as a coin toss in a dense bed, and a mispredicted branch for every other
-/// candidate pair cost the sweep about a fifth of its time.
+/// The mask of the pairs of a block (at most [`BLOCK`]) that have something to do:
+/// they are [`near`], or they hold a history (`held`) that parting lets go. Found
+/// without a branch per pair: whether a pair touches is as good as a coin toss in a
+/// dense bed, and a mispredicted branch for every other candidate pair cost the sweep
+/// about a fifth of its time. The histories themselves are not read: in a bed of
+/// spheres about half of the candidate pairs are apart, and reading their 64-byte
+/// histories to learn that they are empty was a line from memory for each.
 #[inline]
-fn busy_pairs(
-    p: &Particles,
-    radii: &[Real],
-    pairs: &[[u32; 2]],
-    history: &[TangentialHistory],
-) -> u64 {
-    debug_assert!(pairs.len() <= BLOCK && history.len() == pairs.len());
-    let mut busy = 0u64;
-    for (k, (&pair, history)) in pairs.iter().zip(history).enumerate() {
-        busy |= u64::from(near(p, radii, pair) | !history.is_empty()) << k;
+fn busy_pairs(p: &Particles, radii: &[Real], pairs: &[[u32; 2]], held: u64) -> u64 {
+    debug_assert!(pairs.len() <= BLOCK);
+    let mut near_mask = 0u64;
+    for (k, &pair) in pairs.iter().enumerate() {
+        near_mask |= u64::from(near(p, radii, pair)) << k;
     }
-    busy
+    near_mask | held
 }
 
 /// Sets every owned particle's force to its weight plus its pairs' forces, gathered in
