@@ -12,6 +12,8 @@ thread_local dim3 threadIdx, blockIdx, blockDim, gridDim;
 
 #include "vec.cuh"
 #include "contact.cuh"
+#include "overlap.cuh"
+#include "volume_law.cuh"
 
 #include "integrate.cu"
 #include "list.cu"
@@ -21,6 +23,7 @@ thread_local dim3 threadIdx, blockIdx, blockDim, gridDim;
 #include "sums.cu"
 #include "halo.cu"
 #include "figures.cu"
+#include "polyhedra.cu"
 
 // Sets the built-ins of the calling thread before it runs one kernel thread.
 extern "C" void talus_host_at(unsigned block, unsigned thread, unsigned block_dim,
@@ -65,7 +68,8 @@ static const Entry kernels[] = {
     KERNEL(sphere_walls),      KERNEL(wall_sum_rows),    KERNEL(wall_energy_terms),
     KERNEL(pair_energy_partials), KERNEL(sum_records),
     KERNEL(pack_states),       KERNEL(unpack_ghost_states), KERNEL(max_records),
-    KERNEL(particle_figures),
+    KERNEL(particle_figures),  KERNEL(polyhedron_overlaps),
+    KERNEL(polyhedron_contacts),
 };
 
 // The trampoline of the kernel named `name`, or null.

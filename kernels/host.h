@@ -18,12 +18,20 @@ extern thread_local dim3 threadIdx, blockIdx, blockDim, gridDim;
 #define __device__
 #define __forceinline__ inline
 
+using std::cbrt;
+using std::copysign;
+using std::fabs;
 using std::floor;
 using std::isfinite;
 using std::round;
 using std::fmax;
 using std::fmin;
 using std::sqrt;
+
+// One more than the index of the lowest set bit; 0 for none.
+static inline int __ffsll(long long x) {
+    return __builtin_ffsll(x);
+}
 
 static inline unsigned atomicAdd(unsigned* address, unsigned value) {
     return __atomic_fetch_add(address, value, __ATOMIC_RELAXED);

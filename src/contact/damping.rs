@@ -62,6 +62,12 @@ impl DampingTable {
         self.restitution
     }
 
+    /// The damping ratios at the nodes, equally spaced in the force exponent from
+    /// 1/3 to 5, that [`Self::zeta`] interpolates (`kernels/volume_law.cuh` reads them).
+    pub fn nodes(&self) -> &[Real; NODES] {
+        &self.zeta
+    }
+
     /// Damping ratio for a contact whose force grows as `δ^p`.
     pub fn zeta(&self, p: Real) -> Real {
         let s = ((p.clamp(P_MIN, P_MAX) - P_MIN) / (P_MAX - P_MIN)) * (NODES - 1) as Real;

@@ -69,6 +69,12 @@ impl Regularisation {
         self.volume
     }
 
+    /// `V₀^{1/3}`.
+    #[inline]
+    pub fn cbrt(&self) -> Real {
+        self.cbrt
+    }
+
     /// The smaller of two (that of the smaller body of a pair).
     #[inline]
     pub fn min(self, other: Self) -> Self {

@@ -296,6 +296,33 @@ impl ContactLaws {
         }
     }
 
+    /// Per body type, what the device's volume law combines a contact from
+    /// (`kernels/volume_law.cuh`): the stiffness factors, the regularisation, the
+    /// inverse smallest principal moment and the material.
+    #[cfg(feature = "cuda")]
+    pub(super) fn type_rows(
+        &self,
+    ) -> impl Iterator<Item = (PairStiffness, Regularisation, Real, usize)> + '_ {
+        self.types
+            .iter()
+            .map(|t| (t.stiffness, t.regularisation, t.inverse_inertia, t.material))
+    }
+
+    /// Per pair of materials, row-major: the friction coefficient and the damping
+    /// table of the volume law (`None` where no contact follows it).
+    #[cfg(feature = "cuda")]
+    pub(super) fn material_rows(&self) -> impl Iterator<Item = (Real, Option<&DampingTable>)> {
+        self.materials
+            .iter()
+            .map(|m| (m.friction, self.tables.get(m.table)))
+    }
+
+    /// The number of materials the rows are made for.
+    #[cfg(feature = "cuda")]
+    pub(super) fn material_count(&self) -> usize {
+        self.material_count
+    }
+
     /// The damping table of `law`.
     #[inline]
     pub(super) fn damping(&self, law: &PairLaw) -> &DampingTable {

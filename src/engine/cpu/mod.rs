@@ -31,6 +31,8 @@ mod pair_results;
 mod pairs;
 mod patch;
 mod prefetch;
+#[cfg(all(test, feature = "cuda"))]
+pub(in crate::engine) mod reference;
 mod relative_motion;
 mod type_table;
 mod wall_history;

@@ -16,7 +16,9 @@
 pub mod backend;
 pub mod device;
 mod device_list;
+pub mod device_polyhedra;
 mod device_sums;
+pub mod device_volume_contacts;
 mod device_walls;
 pub mod driver;
 pub mod host;
@@ -50,8 +52,22 @@ pub static CONTACT: KernelFile = KernelFile {
     headers: &[],
 };
 
+/// The exact overlap of two convex polyhedra (the bit-mask path).
+pub static OVERLAP: KernelFile = KernelFile {
+    name: "overlap.cuh",
+    source: include_str!("../../../kernels/overlap.cuh"),
+    headers: &[],
+};
+
+/// The volume-based contact law of polyhedra.
+pub static VOLUME_LAW: KernelFile = KernelFile {
+    name: "volume_law.cuh",
+    source: include_str!("../../../kernels/volume_law.cuh"),
+    headers: &[],
+};
+
 /// The kernel files, each compiled to one module.
-pub static FILES: [KernelFile; 8] = [
+pub static FILES: [KernelFile; 9] = [
     KernelFile {
         name: "integrate.cu",
         source: include_str!("../../../kernels/integrate.cu"),
@@ -91,6 +107,11 @@ pub static FILES: [KernelFile; 8] = [
         name: "figures.cu",
         source: include_str!("../../../kernels/figures.cu"),
         headers: &[&VEC, &CONTACT],
+    },
+    KernelFile {
+        name: "polyhedra.cu",
+        source: include_str!("../../../kernels/polyhedra.cu"),
+        headers: &[&VEC, &CONTACT, &OVERLAP, &VOLUME_LAW],
     },
 ];
 
@@ -155,11 +176,15 @@ pub enum Kernel {
     MaxRecords,
     /// Each owned particle's share of the run's figures (`figures.cu`).
     ParticleFigures,
+    /// The overlap of each pair of convex polyhedra at its pose (`polyhedra.cu`).
+    PolyhedronOverlaps,
+    /// The volume-law contacts of candidate pairs of polyhedra (`polyhedra.cu`).
+    PolyhedronContacts,
 }
 
 impl Kernel {
     /// Every kernel.
-    pub const ALL: [Kernel; 29] = [
+    pub const ALL: [Kernel; 31] = [
         Kernel::KickDrift,
         Kernel::ClosingKick,
         Kernel::BinParticles,
@@ -189,6 +214,8 @@ impl Kernel {
         Kernel::UnpackGhostStates,
         Kernel::MaxRecords,
         Kernel::ParticleFigures,
+        Kernel::PolyhedronOverlaps,
+        Kernel::PolyhedronContacts,
     ];
 
     /// Its name in the source (`extern "C"`, so the PTX entry has it too).
@@ -223,6 +250,8 @@ impl Kernel {
             Kernel::UnpackGhostStates => "unpack_ghost_states",
             Kernel::MaxRecords => "max_records",
             Kernel::ParticleFigures => "particle_figures",
+            Kernel::PolyhedronOverlaps => "polyhedron_overlaps",
+            Kernel::PolyhedronContacts => "polyhedron_contacts",
         }
     }
 
@@ -241,6 +270,7 @@ impl Kernel {
             PairEnergyPartials | SumRecords | MaxRecords => 5,
             PackStates | UnpackGhostStates => 6,
             ParticleFigures => 7,
+            PolyhedronOverlaps | PolyhedronContacts => 8,
         };
         &FILES[index]
     }

@@ -1,0 +1,143 @@
+// The contacts of convex polyhedra: `polyhedron_overlaps`, one thread per pair of
+// shapes, the exact overlap at its relative pose (overlap.cuh) as a record of
+// OVERLAP_DOUBLES (volume 0: apart); `polyhedron_contacts`, one thread per
+// candidate pair of particles, the overlap and the volume law's force
+// (volume_law.cuh). Compiled after vec.cuh, contact.cuh, overlap.cuh and
+// volume_law.cuh.
+
+// A pose of B in A's frame: B's centroid (three doubles), then its orientation
+// (w, x, y, z).
+#define POSE_DOUBLES 7u
+
+extern "C" __global__ void polyhedron_overlaps(
+    unsigned n, const unsigned* shape_index, const unsigned* face_span, const unsigned* loops,
+    const Mask* face_masks, const double* vertices, const double* planes,
+    const double* circumradius, const unsigned* pair_shapes, const double* poses,
+    double* records) {
+    unsigned k = blockIdx.x * blockDim.x + threadIdx.x;
+    if (k >= n) {
+        return;
+    }
+    ShapeTable table =
+        ShapeTable{shape_index, face_span, loops, face_masks, vertices, planes, circumradius};
+    const double* pose = poses + POSE_DOUBLES * k;
+    Vec3 t = Vec3{pose[0], pose[1], pose[2]};
+    Quat q = Quat{pose[3], pose[4], pose[5], pose[6]};
+    OverlapScratch scratch;
+    polyhedron_overlap(table, pair_shapes[2 * k], pair_shapes[2 * k + 1], t, q, &scratch,
+                       records + OVERLAP_DOUBLES * k);
+}
+
+// A contact's result under the volume law: the force on the second particle, the
+// torque on the first and on the second, the elastic energy held, the energy
+// dissipated, and 1 where the pair touches (0 apart).
+#define VOLUME_RESULT_DOUBLES 12u
+
+// An orientation as nalgebra stores it: i, j, k, w.
+static __device__ __forceinline__ Quat load_orientation(const double* o, unsigned i) {
+    return Quat{o[4 * i + 3], o[4 * i], o[4 * i + 1], o[4 * i + 2]};
+}
+
+// A particle's angular velocity from its angular momentum (world/mod.rs,
+// World::angular_velocity): principal moments `inertia` in the body frame.
+static __device__ Vec3 angular_velocity(Quat q, Vec3 l, Vec3 inertia, bool isotropic) {
+    if (isotropic) {
+        return Vec3{l.x / inertia.x, l.y / inertia.x, l.z / inertia.x};
+    }
+    Vec3 body = rotate(conjugate(q), l);
+    return rotate(q, Vec3{body.x / inertia.x, body.y / inertia.y, body.z / inertia.z});
+}
+
+// The inverse mass of a body at `point` along `n` (engine/cpu/relative_motion.rs,
+// inverse_mass_at).
+static __device__ double inverse_mass_at(Quat q, Vec3 x, double mass, Vec3 inertia, Vec3 point,
+                                         Vec3 n) {
+    Vec3 lever = rotate(conjugate(q), cross(sub(point, x), n));
+    Vec3 spread = Vec3{lever.x / inertia.x, lever.y / inertia.y, lever.z / inertia.z};
+    return 1.0 / mass + dot(spread, lever);
+}
+
+// One thread per candidate pair of polyhedra: the overlap of the two particles'
+// shapes (overlap.cuh) and, where they overlap, their contact under the volume law
+// (volume_law.cuh) into its result, its history replaced by what the contact
+// leaves; apart, a zero result and history, and the friction spring's energy as
+// dissipated (engine/cpu/pairs.rs, engine/cpu/dispatch.rs pair_geometry,
+// engine/cpu/forces.rs pair_force). Per body type: its shape, mass, principal
+// moments, whether they are equal, its law row (volume_law.cuh) and material; per
+// pair of materials (row-major) its law row.
+extern "C" __global__ void polyhedron_contacts(
+    unsigned pair_count, double dt, const unsigned* pairs, const double* position,
+    const double* orientation, const double* velocity, const double* angular_momentum,
+    const unsigned* body_type, const unsigned* type_shape, const double* type_mass,
+    const double* type_inertia, const unsigned char* type_isotropic, const double* type_law,
+    const unsigned* type_material, unsigned materials, const double* material_law,
+    const unsigned* shape_index, const unsigned* face_span, const unsigned* loops,
+    const Mask* face_masks, const double* vertices, const double* planes,
+    const double* circumradius, double* history, double* results) {
+    unsigned e = blockIdx.x * blockDim.x + threadIdx.x;
+    if (e >= pair_count) {
+        return;
+    }
+    ShapeTable table =
+        ShapeTable{shape_index, face_span, loops, face_masks, vertices, planes, circumradius};
+    unsigned i = pairs[2 * e], j = pairs[2 * e + 1];
+    unsigned ti = body_type[i], tj = body_type[j];
+    Vec3 xi = load3(position, i), xj = load3(position, j);
+    Quat qi = load_orientation(orientation, i), qj = load_orientation(orientation, j);
+    // B's pose in A's frame, as nalgebra's pi.inverse() * pj.
+    Quat inverse = conjugate(qi);
+    Vec3 t = add(rotate(inverse, scale(xi, -1.0)), rotate(inverse, xj));
+    double* h = history + VOLUME_HISTORY_DOUBLES * e;
+    double* result = results + VOLUME_RESULT_DOUBLES * e;
+    OverlapScratch scratch;
+    double o[OVERLAP_DOUBLES];
+    polyhedron_overlap(table, type_shape[ti], type_shape[tj], t, qmul(inverse, qj), &scratch, o);
+    Spring before = Spring{load3(h, 0), h[3]};
+    if (!(o[0] > 0.0)) {
+        for (unsigned k = 0; k < VOLUME_RESULT_DOUBLES; ++k) {
+            result[k] = 0.0;
+        }
+        // The friction spring's energy is let go with the contact.
+        result[10] = spring_energy(before);
+        for (unsigned k = 0; k < VOLUME_HISTORY_DOUBLES; ++k) {
+            h[k] = 0.0;
+        }
+        return;
+    }
+    VolumeGeometry g;
+    g.volume = o[0];
+    g.area = o[7];
+    g.depth = o[8];
+    g.normal = rotate(qi, load3(o + 4, 0));
+    g.point = add(rotate(qi, load3(o + 1, 0)), xi);
+    g.rotation_gradient = rotate(qi, load3(o + 12, 0));
+    g.has_gradient = true;
+    const double* law_i = type_law + TYPE_LAW_DOUBLES * ti;
+    const double* law_j = type_law + TYPE_LAW_DOUBLES * tj;
+    Vec3 inertia_i = load3(type_inertia, ti), inertia_j = load3(type_inertia, tj);
+    Vec3 wi = angular_velocity(qi, load3(angular_momentum, i), inertia_i, type_isotropic[ti]);
+    Vec3 wj = angular_velocity(qj, load3(angular_momentum, j), inertia_j, type_isotropic[tj]);
+    VolumeMotion m;
+    m.velocity = sub(add(load3(velocity, j), cross(wj, sub(g.point, xj))),
+                     add(load3(velocity, i), cross(wi, sub(g.point, xi))));
+    m.spin = sub(wj, wi);
+    m.inverse_mass = inverse_mass_at(qi, xi, type_mass[ti], inertia_i, g.point, g.normal) +
+                     inverse_mass_at(qj, xj, type_mass[tj], inertia_j, g.point, g.normal);
+    m.inertia = 1.0 / (law_i[4] + law_j[4]);
+    // The smaller regularisation volume (that of the smaller body), the first's on a tie.
+    const double* regular = law_j[2] < law_i[2] ? law_j : law_i;
+    const double* material =
+        material_law + MATERIAL_LAW_DOUBLES * (type_material[ti] * materials + type_material[tj]);
+    VolumeContact c = volume_contact(g, m, law_i[0] + law_j[0], law_i[1] + law_j[1], regular[2],
+                                     regular[3], material, before, h[4], dt, xj);
+    Vec3 reaction = scale(add(c.torque, cross(sub(xj, xi), c.force)), -1.0);
+    store3(result, 0, c.force);
+    store3(result, 1, reaction);
+    store3(result, 2, c.torque);
+    result[9] = c.energy;
+    result[10] = c.dissipated;
+    result[11] = 1.0;
+    store3(h, 0, c.kept.spring);
+    h[3] = c.kept.stiffness;
+    h[4] = c.twist;
+}

@@ -1,0 +1,297 @@
+//! The contacts of polyhedra under the volume law on a device
+//! (`kernels/polyhedra.cu`, `polyhedron_contacts`; `kernels/volume_law.cuh`): one
+//! thread per candidate pair finds the overlap of the two particles' shapes and
+//! its force, torques, energy and friction history, as the CPU backend's pair
+//! stage does for a pair of polyhedra (`engine/cpu/dispatch.rs` and
+//! `engine/cpu/forces.rs`).
+//!
+//! What the kernel reads: the particles' states ([`DeviceStates`]), the body types
+//! with their shapes and contact-law rows, and the pairs of materials
+//! ([`DeviceBodyTypes`]), and per pair its history ([`VolumeContacts`]).
+
+use std::collections::HashMap;
+
+use nalgebra::Vector3;
+
+use super::Kernel;
+use super::device::{Arg, Array, Device, DeviceError};
+use super::device_polyhedra::{DeviceShapes, ShapeTableError};
+use crate::Real;
+use crate::contact::TangentialHistory;
+use crate::engine::laws::ContactLaws;
+use crate::engine::params::RoundLaw;
+use crate::geometry::{ConvexPolyhedron, is_isotropic};
+use crate::world::World;
+
+/// Doubles of a body type's law row (`TYPE_LAW_DOUBLES` of volume_law.cuh).
+const TYPE_LAW: usize = 5;
+/// Doubles of a pair of materials' law row (`MATERIAL_LAW_DOUBLES`).
+const MATERIAL_LAW: usize = 23;
+/// Doubles of a contact's history (`VOLUME_HISTORY_DOUBLES`).
+const HISTORY: usize = 5;
+/// Doubles of a contact's result (`VOLUME_RESULT_DOUBLES` of polyhedra.cu).
+const RESULT: usize = 12;
+
+/// The body types of a world of polyhedra and its pairs of materials on a device.
+///
+/// # Invariant
+/// Every body type is a polyhedron whose shape is in `shapes` at `shape[t]`; the
+/// law rows are those of the [`ContactLaws`] they were made from.
+#[derive(Debug, Default)]
+pub struct DeviceBodyTypes {
+    shapes: DeviceShapes,
+    shape: Array<u32>,
+    mass: Array<Real>,
+    /// Principal moments, three per type.
+    inertia: Array<Real>,
+    /// 1 where the three moments are equal (`is_isotropic`).
+    isotropic: Array<u8>,
+    law: Array<Real>,
+    material: Array<u32>,
+    material_count: u32,
+    material_law: Array<Real>,
+}
+
+impl DeviceBodyTypes {
+    /// Uploads the body types and materials of `world`, the laws' rows made for
+    /// the regularisation length `regularisation_length` (relative to each body's
+    /// volume-equivalent radius, as [`crate::engine::params`]' field); body types
+    /// sharing a shape share its copy on the device.
+    pub fn upload(
+        device: &mut dyn Device,
+        world: &World,
+        regularisation_length: Real,
+    ) -> Result<Self, ShapeTableError> {
+        let mut laws = ContactLaws::default();
+        laws.prepare(world, regularisation_length, RoundLaw::Volume);
+        let mut distinct: Vec<&ConvexPolyhedron> = Vec::new();
+        let mut index_of: HashMap<*const ConvexPolyhedron, u32> = HashMap::new();
+        let mut shape = Vec::new();
+        for (t, body) in world.body_types.iter().enumerate() {
+            let polyhedron = body
+                .shape
+                .as_polyhedron()
+                .ok_or(ShapeTableError::NotPolyhedron { body_type: t })?;
+            let k = *index_of.entry(polyhedron).or_insert_with(|| {
+                distinct.push(polyhedron);
+                distinct.len() as u32 - 1
+            });
+            shape.push(k);
+        }
+        let types = &world.body_types;
+        let mut law = Vec::with_capacity(TYPE_LAW * types.len());
+        let mut material = Vec::with_capacity(types.len());
+        for (stiffness, regularisation, inverse_inertia, m) in laws.type_rows() {
+            law.extend([
+                stiffness.normal,
+                stiffness.tangential,
+                regularisation.volume(),
+                regularisation.cbrt(),
+                inverse_inertia,
+            ]);
+            material.push(m as u32);
+        }
+        let mut material_law = Vec::new();
+        for (friction, table) in laws.material_rows() {
+            let table = table.expect("the volume law's damping tables, prepared for polyhedra");
+            material_law.extend([friction, table.restitution()]);
+            material_law.extend(table.nodes());
+        }
+        debug_assert_eq!(
+            material_law.len(),
+            MATERIAL_LAW * laws.material_count().pow(2)
+        );
+        let mut uploaded = DeviceBodyTypes {
+            shapes: DeviceShapes::upload(device, &distinct)?,
+            material_count: laws.material_count() as u32,
+            ..Default::default()
+        };
+        uploaded.shape.write(device, &shape)?;
+        let masses: Vec<Real> = types.iter().map(|b| b.mass).collect();
+        uploaded.mass.write(device, &masses)?;
+        let inertia: Vec<Real> = types
+            .iter()
+            .flat_map(|b| b.inertia.iter().copied())
+            .collect();
+        uploaded.inertia.write(device, &inertia)?;
+        let isotropic: Vec<u8> = types
+            .iter()
+            .map(|b| is_isotropic(&b.inertia) as u8)
+            .collect();
+        uploaded.isotropic.write(device, &isotropic)?;
+        uploaded.law.write(device, &law)?;
+        uploaded.material.write(device, &material)?;
+        uploaded.material_law.write(device, &material_law)?;
+        Ok(uploaded)
+    }
+}
+
+/// The particles' states on a device, as the contact kernels read them: position,
+/// orientation (i, j, k, w, as nalgebra stores it), velocity, angular momentum and
+/// body type.
+#[derive(Debug, Default)]
+pub struct DeviceStates {
+    position: Array<Real>,
+    orientation: Array<Real>,
+    velocity: Array<Real>,
+    angular_momentum: Array<Real>,
+    body_type: Array<u32>,
+}
+
+impl DeviceStates {
+    /// Copies the states of `world`'s particles in.
+    pub fn upload(&mut self, device: &mut dyn Device, world: &World) -> Result<(), DeviceError> {
+        let p = &world.particles;
+        let flat = |v: &[Vector3<Real>]| -> Vec<Real> {
+            v.iter().flat_map(|x| x.iter().copied()).collect()
+        };
+        let position: Vec<Real> = p
+            .position
+            .iter()
+            .flat_map(|x| x.coords.iter().copied())
+            .collect();
+        let orientation: Vec<Real> = p
+            .orientation
+            .iter()
+            .flat_map(|q| q.as_ref().coords.iter().copied())
+            .collect();
+        self.position.write(device, &position)?;
+        self.orientation.write(device, &orientation)?;
+        self.velocity.write(device, &flat(&p.velocity))?;
+        self.angular_momentum
+            .write(device, &flat(&p.angular_momentum))?;
+        self.body_type.write(device, &p.body_type)
+    }
+}
+
+/// One contact's result: what the CPU backend's pair stage gathers.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct VolumeContactResult {
+    /// Force on the second particle; the first gets the opposite.
+    pub force: Vector3<Real>,
+    /// Torque on the first particle and on the second, about their centroids.
+    pub torques: [Vector3<Real>; 2],
+    /// Elastic energy the contact holds.
+    pub energy: Real,
+    /// Energy dissipated over the step (apart: the friction spring's energy let go).
+    pub dissipated: Real,
+    /// Whether the particles touch.
+    pub touching: bool,
+}
+
+/// Candidate pairs of polyhedra on a device, with each pair's friction history and
+/// the results of its last evaluation.
+#[derive(Debug, Default)]
+pub struct VolumeContacts {
+    /// Two particle indices per pair.
+    pairs: Array<u32>,
+    history: Array<Real>,
+    results: Array<Real>,
+    host: Vec<Real>,
+}
+
+impl VolumeContacts {
+    /// Sets the candidate pairs and the history each holds.
+    ///
+    /// # Panics
+    /// When `pairs` and `histories` differ in length.
+    pub fn set_pairs(
+        &mut self,
+        device: &mut dyn Device,
+        pairs: &[(u32, u32)],
+        histories: &[TangentialHistory],
+    ) -> Result<(), DeviceError> {
+        assert_eq!(pairs.len(), histories.len(), "a history per pair");
+        let flat: Vec<u32> = pairs.iter().flat_map(|&(i, j)| [i, j]).collect();
+        self.pairs.write(device, &flat)?;
+        self.host.clear();
+        for h in histories {
+            self.host.extend(h.spring.iter());
+            self.host.extend([h.stiffness, h.twist]);
+        }
+        self.history.write(device, &self.host)?;
+        self.results.resize(device, RESULT * pairs.len())
+    }
+
+    /// Evaluates every pair's contact over a step of `dt` (see the module).
+    ///
+    /// The states must hold every particle a pair names, and the body types every
+    /// body type of those particles.
+    pub fn evaluate(
+        &mut self,
+        device: &mut dyn Device,
+        types: &DeviceBodyTypes,
+        states: &DeviceStates,
+        dt: Real,
+    ) -> Result<(), DeviceError> {
+        let count = self.pairs.len() / 2;
+        if count == 0 {
+            return Ok(());
+        }
+        let mut args = vec![
+            Arg::U32(count as u32),
+            Arg::F64(dt),
+            self.pairs.arg(),
+            states.position.arg(),
+            states.orientation.arg(),
+            states.velocity.arg(),
+            states.angular_momentum.arg(),
+            states.body_type.arg(),
+            types.shape.arg(),
+            types.mass.arg(),
+            types.inertia.arg(),
+            types.isotropic.arg(),
+            types.law.arg(),
+            types.material.arg(),
+            Arg::U32(types.material_count),
+            types.material_law.arg(),
+        ];
+        args.extend(types.shapes.args());
+        args.extend([self.history.arg(), self.results.arg()]);
+        // SAFETY: the arrays' invariants and the caller's: two particles per pair,
+        // a history and a result per pair.
+        unsafe { device.launch(Kernel::PolyhedronContacts, count, &args) }
+    }
+
+    /// The results of the last evaluation.
+    pub fn results(
+        &mut self,
+        device: &dyn Device,
+    ) -> Result<Vec<VolumeContactResult>, DeviceError> {
+        self.results.read_into(device, &mut self.host)?;
+        let v = |r: &[Real], k: usize| Vector3::new(r[k], r[k + 1], r[k + 2]);
+        Ok(self
+            .host
+            .chunks_exact(RESULT)
+            .map(|r| VolumeContactResult {
+                force: v(r, 0),
+                torques: [v(r, 3), v(r, 6)],
+                energy: r[9],
+                dissipated: r[10],
+                touching: r[11] != 0.0,
+            })
+            .collect())
+    }
+
+    /// Each pair's history as the last evaluation left it.
+    pub fn histories(
+        &mut self,
+        device: &dyn Device,
+    ) -> Result<Vec<TangentialHistory>, DeviceError> {
+        self.history.read_into(device, &mut self.host)?;
+        Ok(self
+            .host
+            .chunks_exact(HISTORY)
+            .map(|h| TangentialHistory {
+                spring: Vector3::new(h[0], h[1], h[2]),
+                stiffness: h[3],
+                twist: h[4],
+                ..Default::default()
+            })
+            .collect())
+    }
+}
+
+#[cfg(test)]
+#[path = "device_volume_contacts_tests.rs"]
+mod tests;

@@ -1,0 +1,194 @@
+//! The narrow phase of convex polyhedra on a device (`kernels/overlap.cuh`), run by
+//! the host executor, against the CPU's exact overlap
+//! ([`talus::geometry::overlap::overlap`]): the same pairs overlap, with the same
+//! volume, centroid, area vector, extent and rotation gradients to round-off at
+//! random poses (where the CPU evaluates a kept topology, the kernel clips the
+//! faces), and bit for bit where the CPU clips too (flush faces).
+#![cfg(feature = "cuda")]
+
+use nalgebra::{Isometry3, Quaternion, Translation3, UnitQuaternion, Vector3};
+use rand::{Rng, SeedableRng};
+use rand_pcg::Pcg64;
+use talus::engine::cuda::device::HostDevice;
+use talus::engine::cuda::device_polyhedra::{DeviceShapes, PolyhedronPairs, ShapeTableError};
+use talus::geometry::overlap::{OverlapGeometry, overlap};
+use talus::geometry::{ConvexPolyhedron, Pose, generators};
+
+/// A random orientation, uniform over the turns.
+fn rotation(random: &mut Pcg64) -> UnitQuaternion<f64> {
+    let mut c = || random.random_range(-1.0..1.0);
+    UnitQuaternion::from_quaternion(Quaternion::new(c(), c(), c(), c()))
+}
+
+/// A random unit vector.
+fn direction(random: &mut Pcg64) -> Vector3<f64> {
+    loop {
+        let v = Vector3::from_fn(|_, _| random.random_range(-1.0..1.0));
+        let n = v.norm();
+        if n > 0.1 && n <= 1.0 {
+            return v / n;
+        }
+    }
+}
+
+/// Shapes of unit size: a dodecahedron, a cube, a hexagonal prism and random convex
+/// hulls of 14 and of 40 points.
+fn shapes() -> Vec<ConvexPolyhedron> {
+    let mut shapes = vec![
+        generators::dodecahedron(1.0).unwrap(),
+        generators::cuboid(1.2, 1.2, 1.2).unwrap(),
+        generators::prism(6, 1.6, 1.0).unwrap(),
+    ];
+    for seed in 0..4 {
+        shapes.push(generators::random_convex(14, 1.0, 0.3, seed).unwrap());
+    }
+    shapes.push(generators::random_convex(40, 1.0, 0.2, 7).unwrap());
+    shapes
+}
+
+/// Differences of two overlaps, each scaled by the shapes' size `l` to the power of
+/// the quantity's length dimension.
+#[derive(Debug, Default)]
+struct Worst {
+    volume: f64,
+    moment: f64,
+    area_vector: f64,
+    depth: f64,
+    gradients: f64,
+}
+
+impl Worst {
+    fn add(&mut self, cpu: &OverlapGeometry, device: &OverlapGeometry) {
+        let biggest = |a: &mut f64, d: f64| *a = a.max(d);
+        biggest(&mut self.volume, (cpu.volume - device.volume).abs());
+        // The centroid times the volume: well conditioned however small the overlap.
+        let moment = |g: &OverlapGeometry| g.centroid.coords * g.volume;
+        biggest(&mut self.moment, (moment(cpu) - moment(device)).norm());
+        biggest(
+            &mut self.area_vector,
+            (cpu.area_vector() - device.area_vector()).norm(),
+        );
+        // The extent along a normal that is well defined.
+        if cpu.area > 1e-6 {
+            biggest(&mut self.depth, (cpu.depth - device.depth).abs());
+        }
+        biggest(
+            &mut self.gradients,
+            (cpu.rotation_gradient_a - device.rotation_gradient_a).norm()
+                + (cpu.rotation_gradient_b - device.rotation_gradient_b).norm(),
+        );
+    }
+}
+
+#[test]
+fn device_overlaps_equal_the_cpu_overlap_at_random_poses() {
+    let shapes = shapes();
+    let refs: Vec<&ConvexPolyhedron> = shapes.iter().collect();
+    let mut device = HostDevice::new(64);
+    let table = DeviceShapes::upload(&mut device, &refs).unwrap();
+    let mut random = Pcg64::seed_from_u64(23);
+    let (mut pairs, mut poses) = (Vec::new(), Vec::new());
+    for _ in 0..3000 {
+        let a = random.random_range(0..shapes.len());
+        let b = random.random_range(0..shapes.len());
+        // Centres from deep inside to beyond reach.
+        let reach = shapes[a].circumradius() + shapes[b].circumradius();
+        let distance = reach * random.random_range(0.15..1.05);
+        let translation = Translation3::from(direction(&mut random) * distance);
+        pairs.push((a as u32, b as u32));
+        poses.push(Isometry3::from_parts(translation, rotation(&mut random)));
+    }
+    let on_device = PolyhedronPairs::default()
+        .overlaps(&mut device, &table, &pairs, &poses)
+        .unwrap();
+    let mut worst = Worst::default();
+    let mut overlapping = 0;
+    for (k, (&(a, b), pose)) in pairs.iter().zip(&poses).enumerate() {
+        let cpu = overlap(&shapes[a as usize], &shapes[b as usize], pose);
+        match (&cpu, &on_device[k]) {
+            (Some(cpu), Some(device)) => {
+                overlapping += 1;
+                worst.add(cpu, device);
+            }
+            (None, None) => {}
+            _ => panic!(
+                "pair {k} ({a}, {b}): the CPU finds {cpu:?}, the device {:?}",
+                on_device[k]
+            ),
+        }
+    }
+    eprintln!("{overlapping} of 3000 overlap; largest differences (unit shapes): {worst:?}");
+    // Both ways, and deep and shallow contacts among them.
+    assert!((1000..2900).contains(&overlapping), "{overlapping}");
+    // The shapes are of unit size: round-off of doubles is 1e-16 (the largest
+    // differences found are 4e-16 to 9e-16); the bound leaves room for sums over a
+    // few dozen pieces whose cut points the CPU's topology finds along other edges.
+    for difference in [
+        worst.volume,
+        worst.moment,
+        worst.area_vector,
+        worst.depth,
+        worst.gradients,
+    ] {
+        assert!(difference < 1e-14, "{worst:?}");
+    }
+}
+
+#[test]
+fn device_overlaps_of_flush_cubes_are_the_cpus_bit_for_bit() {
+    // Cubes of a lattice, side by side and shifted: flush faces, which the CPU
+    // clips as the kernel does (no topology), and the volume of the box overlap.
+    let cube = generators::cuboid(1.0, 1.0, 1.0).unwrap();
+    let mut device = HostDevice::new(64);
+    let table = DeviceShapes::upload(&mut device, &[&cube]).unwrap();
+    let shifts = [
+        Vector3::new(0.0, 0.3, 0.8),
+        Vector3::new(0.0, 0.0, 0.9),
+        Vector3::new(0.25, 0.5, 0.75),
+        Vector3::new(-0.1, 0.0, -0.6),
+        Vector3::new(0.0, 0.0, 0.0),
+    ];
+    let poses: Vec<Pose> = shifts
+        .iter()
+        .map(|&s| Isometry3::translation(s.x, s.y, s.z))
+        .collect();
+    let pairs = vec![(0, 0); poses.len()];
+    let on_device = PolyhedronPairs::default()
+        .overlaps(&mut device, &table, &pairs, &poses)
+        .unwrap();
+    for (shift, device) in shifts.iter().zip(&on_device) {
+        let cpu = overlap(
+            &cube,
+            &cube,
+            &Isometry3::translation(shift.x, shift.y, shift.z),
+        );
+        assert_eq!(&cpu, device, "shift {shift}");
+        let expected: f64 = shift.iter().map(|s| 1.0 - s.abs()).product();
+        let volume = device.map_or(0.0, |g| g.volume);
+        assert!(
+            (volume - expected).abs() < 1e-15,
+            "shift {shift}: {volume} against {expected}"
+        );
+    }
+}
+
+#[test]
+fn a_shape_beyond_the_kernels_masks_is_refused_by_name() {
+    let sphere = generators::icosphere(2, 1.0).unwrap();
+    let cube = generators::cuboid(1.0, 1.0, 1.0).unwrap();
+    let mut device = HostDevice::new(64);
+    let error = DeviceShapes::upload(&mut device, &[&cube, &sphere]).unwrap_err();
+    assert!(matches!(
+        error,
+        ShapeTableError::TooLarge {
+            index: 1,
+            vertices: 162,
+            ..
+        }
+    ));
+    let message = error.to_string();
+    assert!(
+        message.contains("shape 1 has 162 vertices and 320 faces"),
+        "{message}"
+    );
+}
