@@ -12,8 +12,10 @@ thread_local dim3 threadIdx, blockIdx, blockDim, gridDim;
 
 #include "vec.cuh"
 #include "contact.cuh"
+#include "triangle.cuh"
 #include "overlap.cuh"
 #include "volume_law.cuh"
+#include "facet.cuh"
 
 #include "integrate.cu"
 #include "list.cu"
@@ -69,7 +71,7 @@ static const Entry kernels[] = {
     KERNEL(pair_energy_partials), KERNEL(sum_records),
     KERNEL(pack_states),       KERNEL(unpack_ghost_states), KERNEL(max_records),
     KERNEL(particle_figures),  KERNEL(polyhedron_overlaps),
-    KERNEL(polyhedron_contacts),
+    KERNEL(polyhedron_contacts), KERNEL(polyhedron_facets),
 };
 
 // The trampoline of the kernel named `name`, or null.

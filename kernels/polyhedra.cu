@@ -2,8 +2,10 @@
 // shapes, the exact overlap at its relative pose (overlap.cuh) as a record of
 // OVERLAP_DOUBLES (volume 0: apart); `polyhedron_contacts`, one thread per
 // candidate pair of particles, the overlap and the volume law's force
-// (volume_law.cuh). Compiled after vec.cuh, contact.cuh, overlap.cuh and
-// volume_law.cuh.
+// (volume_law.cuh); `polyhedron_facets`, one thread per particle shape and wall
+// triangle, the overlap with the prism under the triangle (facet.cuh). Compiled
+// after vec.cuh, contact.cuh, triangle.cuh, overlap.cuh, volume_law.cuh and
+// facet.cuh.
 
 // A pose of B in A's frame: B's centroid (three doubles), then its orientation
 // (w, x, y, z).
@@ -140,4 +142,28 @@ extern "C" __global__ void polyhedron_contacts(
     store3(h, 0, c.kept.spring);
     h[3] = c.kept.stiffness;
     h[4] = c.twist;
+}
+
+// One thread per query: shape `shapes[k]` against the triangle `triangles[9k..]`
+// (its body frame, counter-clockwise seen from the particle), the overlap with the
+// prism under it as a record of FACET_DOUBLES (volume 0: none).
+extern "C" __global__ void polyhedron_facets(
+    unsigned n, const unsigned* shape_index, const unsigned* face_span, const unsigned* loops,
+    const Mask* face_masks, const double* vertices, const double* planes,
+    const double* circumradius, const unsigned* shapes, const double* triangles,
+    double* records) {
+    unsigned k = blockIdx.x * blockDim.x + threadIdx.x;
+    if (k >= n) {
+        return;
+    }
+    ShapeTable table =
+        ShapeTable{shape_index, face_span, loops, face_masks, vertices, planes, circumradius};
+    Side side;
+    Polygon poly;
+    Mat3 identity = Mat3{{1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0}};
+    place_side(table, shapes[k], false, identity, Vec3{0.0, 0.0, 0.0}, &side);
+    Vec3 tri[3] = {load3(triangles, 3 * k), load3(triangles, 3 * k + 1),
+                   load3(triangles, 3 * k + 2)};
+    facet_overlap(table, &side, circumradius[shapes[k]], tri, &poly,
+                  records + FACET_DOUBLES * k);
 }

@@ -3,15 +3,20 @@
 //! ([`talus::geometry::overlap::overlap`]): the same pairs overlap, with the same
 //! volume, centroid, area vector, extent and rotation gradients to round-off at
 //! random poses (where the CPU evaluates a kept topology, the kernel clips the
-//! faces), and bit for bit where the CPU clips too (flush faces).
+//! faces), and bit for bit where the CPU clips too (flush faces); and the overlap
+//! of a shape with the prism under a wall facet against the CPU's
+//! ([`talus::geometry::wall::polyhedron_triangle`]), bit for bit.
 #![cfg(feature = "cuda")]
 
-use nalgebra::{Isometry3, Quaternion, Translation3, UnitQuaternion, Vector3};
+use nalgebra::{Isometry3, Point3, Quaternion, Translation3, UnitQuaternion, Vector3};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 use talus::engine::cuda::device::HostDevice;
-use talus::engine::cuda::device_polyhedra::{DeviceShapes, PolyhedronPairs, ShapeTableError};
+use talus::engine::cuda::device_polyhedra::{
+    DeviceShapes, FacetQueries, PolyhedronPairs, ShapeTableError,
+};
 use talus::geometry::overlap::{OverlapGeometry, overlap};
+use talus::geometry::wall::polyhedron_triangle;
 use talus::geometry::{ConvexPolyhedron, Pose, generators};
 
 /// A random orientation, uniform over the turns.
@@ -191,4 +196,54 @@ fn a_shape_beyond_the_kernels_masks_is_refused_by_name() {
         message.contains("shape 1 has 162 vertices and 320 faces"),
         "{message}"
     );
+}
+
+#[test]
+fn device_facet_overlaps_are_the_cpus_bit_for_bit() {
+    let shapes = shapes();
+    let refs: Vec<&ConvexPolyhedron> = shapes.iter().collect();
+    let mut device = HostDevice::new(64);
+    let table = DeviceShapes::upload(&mut device, &refs).unwrap();
+    let mut random = Pcg64::seed_from_u64(29);
+    let mut queries = Vec::new();
+    for k in 0..3000 {
+        let s = random.random_range(0..shapes.len());
+        // The facet's plane a random height below the centroid, its normal towards
+        // the particle; large triangles (the particle within their sides) and
+        // small ones (cut by their sides), anywhere in the plane.
+        let up = direction(&mut random);
+        let height = shapes[s].circumradius() * random.random_range(0.1..1.1);
+        let across = up.cross(&direction(&mut random)).normalize();
+        let along = up.cross(&across);
+        let size = if k % 2 == 0 {
+            10.0
+        } else {
+            random.random_range(0.2..1.5)
+        };
+        let centre = -up * height
+            + (across * random.random_range(-1.0..1.0) + along * random.random_range(-1.0..1.0));
+        let corner =
+            |angle: f64| Point3::from(centre + (across * angle.cos() + along * angle.sin()) * size);
+        let turn = random.random_range(0.0..1.0);
+        let tri = [corner(turn), corner(turn + 2.1), corner(turn + 4.2)];
+        queries.push((s as u32, tri));
+    }
+    let on_device = FacetQueries::default()
+        .overlaps(&mut device, &table, &queries)
+        .unwrap();
+    let (mut touching, mut cut) = (0, 0);
+    for (k, (s, tri)) in queries.iter().enumerate() {
+        let cpu = polyhedron_triangle(&shapes[*s as usize], tri);
+        assert_eq!(cpu, on_device[k], "query {k}");
+        if let Some(o) = cpu {
+            touching += 1;
+            // The facet's normal points to the particle's side (the centroid lies
+            // above its plane); the small triangles' prisms cut the particle by
+            // their sides (inradius below the circumradius).
+            assert!(o.facet_normal.dot(&Vector3::from(tri[0].coords)) < 0.0);
+            cut += (k % 2) as usize;
+        }
+    }
+    eprintln!("{touching} of 3000 facet queries overlap, {cut} of them small triangles");
+    assert!(touching > 1000 && cut > 300, "{touching} {cut}");
 }

@@ -1,6 +1,8 @@
-//! Convex polyhedra on a device (`kernels/overlap.cuh`, `kernels/polyhedra.cu`): a
-//! table of shapes in flat arrays, and the narrow phase of polyhedron pairs, one
-//! thread per pair, each the exact overlap of its two shapes at its relative pose.
+//! Convex polyhedra on a device (`kernels/overlap.cuh`, `kernels/facet.cuh`,
+//! `kernels/polyhedra.cu`): a table of shapes in flat arrays, the narrow phase of
+//! polyhedron pairs, one thread per pair, each the exact overlap of its two shapes
+//! at its relative pose, and the overlap of a shape with the prism under a wall
+//! facet, one thread per query.
 //!
 //! The kernel takes the bit-mask path of [`crate::geometry::overlap`] afresh at
 //! every call: it keeps no plan or topology between calls, so where the CPU
@@ -14,6 +16,7 @@ use super::Kernel;
 use super::device::{Arg, Array, Device, DeviceError};
 use crate::Real;
 use crate::geometry::overlap::OverlapGeometry;
+use crate::geometry::wall::FacetOverlap;
 use crate::geometry::{ConvexPolyhedron, Pose};
 
 /// Most faces, and most vertices, of a shape the device takes (`MASK_FACES`,
@@ -21,6 +24,8 @@ use crate::geometry::{ConvexPolyhedron, Pose};
 pub const MAX_SHAPE_PARTS: usize = 64;
 /// Doubles of an overlap's record (`OVERLAP_DOUBLES` of overlap.cuh).
 const RECORD: usize = 15;
+/// Doubles of a facet overlap's record (`FACET_DOUBLES` of facet.cuh).
+const FACET_RECORD: usize = 15;
 /// Doubles of a pose of B in A (`POSE_DOUBLES` of polyhedra.cu).
 const POSE: usize = 7;
 
@@ -229,6 +234,72 @@ impl PolyhedronPairs {
             .host
             .chunks_exact(RECORD)
             .map(overlap_of_record)
+            .collect())
+    }
+}
+
+/// The per-query arrays of the polyhedra's wall-facet overlaps on a device, kept
+/// from call to call.
+#[derive(Debug, Default)]
+pub struct FacetQueries {
+    shapes: Array<u32>,
+    /// Three vertices per query.
+    triangles: Array<Real>,
+    records: Array<Real>,
+    host: Vec<Real>,
+}
+
+impl FacetQueries {
+    /// The overlap of each shape `queries[k].0` (an index into `table`) with the
+    /// prism under the triangle `queries[k].1` (in the shape's body frame), as
+    /// [`crate::geometry::wall::polyhedron_triangle`] gives it.
+    ///
+    /// # Panics
+    /// When a query names a shape beyond the table.
+    pub fn overlaps(
+        &mut self,
+        device: &mut dyn Device,
+        table: &DeviceShapes,
+        queries: &[(u32, [Point3<Real>; 3])],
+    ) -> Result<Vec<Option<FacetOverlap>>, DeviceError> {
+        assert!(
+            queries.iter().all(|&(s, _)| (s as usize) < table.len()),
+            "queries of the table's shapes"
+        );
+        if queries.is_empty() {
+            return Ok(Vec::new());
+        }
+        let shapes: Vec<u32> = queries.iter().map(|q| q.0).collect();
+        self.host.clear();
+        for (_, tri) in queries {
+            self.host
+                .extend(tri.iter().flat_map(|p| p.coords.iter().copied()));
+        }
+        self.shapes.write(device, &shapes)?;
+        self.triangles.write(device, &self.host)?;
+        self.records.resize(device, FACET_RECORD * queries.len())?;
+        let mut args = vec![Arg::U32(queries.len() as u32)];
+        args.extend(table.args());
+        args.extend([self.shapes.arg(), self.triangles.arg(), self.records.arg()]);
+        // SAFETY: the table's invariant; a shape and a triangle per query, a record
+        // written per query.
+        unsafe { device.launch(Kernel::PolyhedronFacets, queries.len(), &args)? };
+        self.records.read_into(device, &mut self.host)?;
+        let v = |r: &[Real], k: usize| Vector3::new(r[k], r[k + 1], r[k + 2]);
+        Ok(self
+            .host
+            .chunks_exact(FACET_RECORD)
+            .map(|r| {
+                (r[0] > 0.0).then(|| FacetOverlap {
+                    volume: r[0],
+                    centroid: Point3::from(v(r, 1)),
+                    volume_gradient: v(r, 4),
+                    rotation_gradient: v(r, 7),
+                    depth: r[10],
+                    section_area: r[11],
+                    facet_normal: v(r, 12),
+                })
+            })
             .collect())
     }
 }

@@ -66,6 +66,20 @@ pub static VOLUME_LAW: KernelFile = KernelFile {
     headers: &[],
 };
 
+/// The point of a triangle closest to a point.
+pub static TRIANGLE: KernelFile = KernelFile {
+    name: "triangle.cuh",
+    source: include_str!("../../../kernels/triangle.cuh"),
+    headers: &[],
+};
+
+/// The overlap of a convex polyhedron with the prism under a wall facet.
+pub static FACET: KernelFile = KernelFile {
+    name: "facet.cuh",
+    source: include_str!("../../../kernels/facet.cuh"),
+    headers: &[],
+};
+
 /// The kernel files, each compiled to one module.
 pub static FILES: [KernelFile; 9] = [
     KernelFile {
@@ -91,7 +105,7 @@ pub static FILES: [KernelFile; 9] = [
     KernelFile {
         name: "walls.cu",
         source: include_str!("../../../kernels/walls.cu"),
-        headers: &[&VEC, &CONTACT],
+        headers: &[&VEC, &CONTACT, &TRIANGLE],
     },
     KernelFile {
         name: "sums.cu",
@@ -111,7 +125,7 @@ pub static FILES: [KernelFile; 9] = [
     KernelFile {
         name: "polyhedra.cu",
         source: include_str!("../../../kernels/polyhedra.cu"),
-        headers: &[&VEC, &CONTACT, &OVERLAP, &VOLUME_LAW],
+        headers: &[&VEC, &CONTACT, &TRIANGLE, &OVERLAP, &VOLUME_LAW, &FACET],
     },
 ];
 
@@ -180,11 +194,13 @@ pub enum Kernel {
     PolyhedronOverlaps,
     /// The volume-law contacts of candidate pairs of polyhedra (`polyhedra.cu`).
     PolyhedronContacts,
+    /// The overlap of polyhedra with the prisms under wall facets (`polyhedra.cu`).
+    PolyhedronFacets,
 }
 
 impl Kernel {
     /// Every kernel.
-    pub const ALL: [Kernel; 31] = [
+    pub const ALL: [Kernel; 32] = [
         Kernel::KickDrift,
         Kernel::ClosingKick,
         Kernel::BinParticles,
@@ -216,6 +232,7 @@ impl Kernel {
         Kernel::ParticleFigures,
         Kernel::PolyhedronOverlaps,
         Kernel::PolyhedronContacts,
+        Kernel::PolyhedronFacets,
     ];
 
     /// Its name in the source (`extern "C"`, so the PTX entry has it too).
@@ -252,6 +269,7 @@ impl Kernel {
             Kernel::ParticleFigures => "particle_figures",
             Kernel::PolyhedronOverlaps => "polyhedron_overlaps",
             Kernel::PolyhedronContacts => "polyhedron_contacts",
+            Kernel::PolyhedronFacets => "polyhedron_facets",
         }
     }
 
@@ -270,7 +288,7 @@ impl Kernel {
             PairEnergyPartials | SumRecords | MaxRecords => 5,
             PackStates | UnpackGhostStates => 6,
             ParticleFigures => 7,
-            PolyhedronOverlaps | PolyhedronContacts => 8,
+            PolyhedronOverlaps | PolyhedronContacts | PolyhedronFacets => 8,
         };
         &FILES[index]
     }

@@ -1,0 +1,37 @@
+// The point of a triangle closest to a point (geometry/sphere.rs,
+// closest_point_on_triangle: Ericson's Voronoi-region tests), shared by the
+// spheres' wall contacts (walls.cu) and the polyhedra's (facet.cuh). Compiled
+// after vec.cuh.
+
+static __device__ __forceinline__ Vec3 closest_on_triangle(Vec3 a, Vec3 b, Vec3 c, Vec3 p) {
+    Vec3 ab = sub(b, a), ac = sub(c, a), ap = sub(p, a);
+    double d1 = dot(ab, ap), d2 = dot(ac, ap);
+    if (d1 <= 0.0 && d2 <= 0.0) {
+        return a;
+    }
+    Vec3 bp = sub(p, b);
+    double d3 = dot(ab, bp), d4 = dot(ac, bp);
+    if (d3 >= 0.0 && d4 <= d3) {
+        return b;
+    }
+    double vc = d1 * d4 - d3 * d2;
+    if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) {
+        return add(a, scale(ab, d1 / (d1 - d3)));
+    }
+    Vec3 cp = sub(p, c);
+    double d5 = dot(ab, cp), d6 = dot(ac, cp);
+    if (d6 >= 0.0 && d5 <= d6) {
+        return c;
+    }
+    double vb = d5 * d2 - d1 * d6;
+    if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) {
+        return add(a, scale(ac, d2 / (d2 - d6)));
+    }
+    double va = d3 * d6 - d5 * d4;
+    if (va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0) {
+        double w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        return add(b, scale(sub(c, b), w));
+    }
+    double denom = 1.0 / (va + vb + vc);
+    return add(add(a, scale(ab, vb * denom)), scale(ac, vc * denom));
+}
