@@ -81,18 +81,6 @@ static __device__ bool face_behind(const ShapeTable& table, const Side* side, un
     return false;
 }
 
-// Face `f` of `side` as a polygon.
-static __device__ void set_face(const ShapeTable& table, const Side* side, unsigned f,
-                                Polygon* poly) {
-    unsigned first = table.face_span[2 * (side->face_base + f)];
-    unsigned count = table.face_span[2 * (side->face_base + f) + 1];
-    poly->current = 0;
-    poly->len = count < MAX_CLIPPED ? count : MAX_CLIPPED;
-    for (unsigned k = 0; k < poly->len; ++k) {
-        poly->buffers[0][k] = side->points[table.loops[first + k]];
-    }
-}
-
 // Clips the polygon by `planes` in order until fewer than three vertices remain;
 // whether three or more are left.
 static __device__ bool clip_by(Polygon* poly, const Plane* planes, unsigned count) {

@@ -262,17 +262,23 @@ static __device__ void clip_polygon(Polygon* poly, Plane plane) {
     poly->len = m;
 }
 
+// Face `f` of `side` as a polygon.
+static __device__ void set_face(const ShapeTable& table, const Side* side, unsigned f,
+                                Polygon* poly) {
+    unsigned first = table.face_span[2 * (side->face_base + f)];
+    unsigned count = table.face_span[2 * (side->face_base + f) + 1];
+    poly->current = 0;
+    poly->len = count < MAX_CLIPPED ? count : MAX_CLIPPED;
+    for (unsigned k = 0; k < poly->len; ++k) {
+        poly->buffers[0][k] = side->points[table.loops[first + k]];
+    }
+}
+
 // Face `f` of `own` clipped by the planes `cut` of `other` (masked.rs,
 // clip_by_planes): false when fewer than three vertices remain.
 static __device__ bool clipped_face(const ShapeTable& table, const Side* own, const Side* other,
                                     unsigned f, Mask cut, Polygon* poly) {
-    unsigned first = table.face_span[2 * (own->face_base + f)];
-    unsigned count = table.face_span[2 * (own->face_base + f) + 1];
-    poly->current = 0;
-    poly->len = count < MAX_CLIPPED ? count : MAX_CLIPPED;
-    for (unsigned k = 0; k < poly->len; ++k) {
-        poly->buffers[0][k] = own->points[table.loops[first + k]];
-    }
+    set_face(table, own, f, poly);
     for (; cut != 0; cut &= cut - 1) {
         clip_polygon(poly, other->planes[lowest_bit(cut)]);
         if (poly->len < 3) {

@@ -6,14 +6,16 @@
 #   scripts/gpu-check.sh              builds the `cuda` feature with cargo, then runs
 #   scripts/gpu-check.sh BIN_DIR      runs binaries built elsewhere (a GPU machine
 #                                     without Rust): BIN_DIR holds `talus` and the
-#                                     test binaries cuda_kernels, cuda_spheres and
-#                                     cuda_backend (`cargo test --release --features
+#                                     test binaries cuda_kernels, cuda_spheres,
+#                                     cuda_backend and cuda_polyhedra (`cargo test --release --features
 #                                     cuda --no-run` names them, with a hash)
 # What it runs: every kernel compiled by NVRTC for sm_80 and sm_90
 # (tests/cuda_kernels.rs); the converging cloud, the cloud thrown into a box and the
 # turning drum on GPU 0 against the CPU backend, the particles to the bit and the
 # sums to 1e-12 (tests/cuda_spheres.rs, `on_a_gpu_...`); the backend under a whole
-# simulation through the host executor (tests/cuda_backend.rs); the benchmark.
+# simulation through the host executor (tests/cuda_backend.rs); the polyhedra's
+# overlaps and facet overlaps on GPU 0 against the CPU's (tests/cuda_polyhedra.rs,
+# `on_a_gpu_...`); the benchmark.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 nvidia-smi --query-gpu=name,driver_version,memory.total --format=csv,noheader
@@ -37,9 +39,10 @@ if [ $# -ge 1 ]; then
     "$bin/cuda_kernels" --nocapture
     "$bin/cuda_spheres" on_a_gpu --nocapture
     "$bin/cuda_backend"
+    "$bin/cuda_polyhedra" on_a_gpu --nocapture
 else
     cargo test --release --features cuda --test cuda_kernels --test cuda_spheres \
-        --test cuda_backend -- --nocapture
+        --test cuda_backend --test cuda_polyhedra -- --nocapture
     cargo build --release --features cuda --bin talus
     talus=target/release/talus
 fi

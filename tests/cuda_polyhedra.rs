@@ -11,10 +11,11 @@
 use nalgebra::{Isometry3, Point3, Quaternion, Translation3, UnitQuaternion, Vector3};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
-use talus::engine::cuda::device::HostDevice;
+use talus::engine::cuda::device::{Device, HostDevice};
 use talus::engine::cuda::device_polyhedra::{
     DeviceShapes, FacetQueries, PolyhedronPairs, ShapeTableError,
 };
+use talus::engine::cuda::driver::CudaDevice;
 use talus::geometry::overlap::{OverlapGeometry, overlap};
 use talus::geometry::wall::polyhedron_triangle;
 use talus::geometry::{ConvexPolyhedron, Pose, generators};
@@ -87,10 +88,13 @@ impl Worst {
 
 #[test]
 fn device_overlaps_equal_the_cpu_overlap_at_random_poses() {
+    overlaps_at_random_poses(&mut HostDevice::new(64));
+}
+
+fn overlaps_at_random_poses(device: &mut dyn Device) {
     let shapes = shapes();
     let refs: Vec<&ConvexPolyhedron> = shapes.iter().collect();
-    let mut device = HostDevice::new(64);
-    let table = DeviceShapes::upload(&mut device, &refs).unwrap();
+    let table = DeviceShapes::upload(device, &refs).unwrap();
     let mut random = Pcg64::seed_from_u64(23);
     let (mut pairs, mut poses) = (Vec::new(), Vec::new());
     for _ in 0..3000 {
@@ -104,7 +108,7 @@ fn device_overlaps_equal_the_cpu_overlap_at_random_poses() {
         poses.push(Isometry3::from_parts(translation, rotation(&mut random)));
     }
     let on_device = PolyhedronPairs::default()
-        .overlaps(&mut device, &table, &pairs, &poses)
+        .overlaps(device, &table, &pairs, &poses)
         .unwrap();
     let mut worst = Worst::default();
     let mut overlapping = 0;
@@ -141,11 +145,14 @@ fn device_overlaps_equal_the_cpu_overlap_at_random_poses() {
 
 #[test]
 fn device_overlaps_of_flush_cubes_are_the_cpus_bit_for_bit() {
+    flush_cubes(&mut HostDevice::new(64));
+}
+
+fn flush_cubes(device: &mut dyn Device) {
     // Cubes of a lattice, side by side and shifted: flush faces, which the CPU
     // clips as the kernel does (no topology), and the volume of the box overlap.
     let cube = generators::cuboid(1.0, 1.0, 1.0).unwrap();
-    let mut device = HostDevice::new(64);
-    let table = DeviceShapes::upload(&mut device, &[&cube]).unwrap();
+    let table = DeviceShapes::upload(device, &[&cube]).unwrap();
     let shifts = [
         Vector3::new(0.0, 0.3, 0.8),
         Vector3::new(0.0, 0.0, 0.9),
@@ -159,7 +166,7 @@ fn device_overlaps_of_flush_cubes_are_the_cpus_bit_for_bit() {
         .collect();
     let pairs = vec![(0, 0); poses.len()];
     let on_device = PolyhedronPairs::default()
-        .overlaps(&mut device, &table, &pairs, &poses)
+        .overlaps(device, &table, &pairs, &poses)
         .unwrap();
     for (shift, device) in shifts.iter().zip(&on_device) {
         let cpu = overlap(
@@ -200,10 +207,13 @@ fn a_shape_beyond_the_kernels_masks_is_refused_by_name() {
 
 #[test]
 fn device_facet_overlaps_are_the_cpus_bit_for_bit() {
+    facet_overlaps(&mut HostDevice::new(64));
+}
+
+fn facet_overlaps(device: &mut dyn Device) {
     let shapes = shapes();
     let refs: Vec<&ConvexPolyhedron> = shapes.iter().collect();
-    let mut device = HostDevice::new(64);
-    let table = DeviceShapes::upload(&mut device, &refs).unwrap();
+    let table = DeviceShapes::upload(device, &refs).unwrap();
     let mut random = Pcg64::seed_from_u64(29);
     let mut queries = Vec::new();
     for k in 0..3000 {
@@ -229,7 +239,7 @@ fn device_facet_overlaps_are_the_cpus_bit_for_bit() {
         queries.push((s as u32, tri));
     }
     let on_device = FacetQueries::default()
-        .overlaps(&mut device, &table, &queries)
+        .overlaps(device, &table, &queries)
         .unwrap();
     let (mut touching, mut cut) = (0, 0);
     for (k, (s, tri)) in queries.iter().enumerate() {
@@ -241,9 +251,32 @@ fn device_facet_overlaps_are_the_cpus_bit_for_bit() {
             // above its plane); the small triangles' prisms cut the particle by
             // their sides (inradius below the circumradius).
             assert!(o.facet_normal.dot(&Vector3::from(tri[0].coords)) < 0.0);
-            cut += (k % 2) as usize;
+            cut += k % 2;
         }
     }
     eprintln!("{touching} of 3000 facet queries overlap, {cut} of them small triangles");
     assert!(touching > 1000 && cut > 300, "{touching} {cut}");
+}
+
+/// The same comparisons on a GPU, where there is one (`scripts/gpu-check.sh`): the
+/// kernels are compiled without fused multiply–adds and with IEEE division and
+/// square roots, so the facets and the flush cubes give the CPU's bits there too.
+/// Without a driver the test says so and passes, unless `TALUS_REQUIRE_GPU` is set.
+#[test]
+fn on_a_gpu_overlaps_and_facet_overlaps_are_the_cpus() {
+    match CudaDevice::open(0) {
+        Ok(mut gpu) => {
+            eprintln!("on {gpu:?}");
+            overlaps_at_random_poses(&mut gpu);
+            flush_cubes(&mut gpu);
+            facet_overlaps(&mut gpu);
+        }
+        Err(e) => {
+            assert!(
+                std::env::var_os("TALUS_REQUIRE_GPU").is_none(),
+                "TALUS_REQUIRE_GPU is set: {e}"
+            );
+            eprintln!("skipped: {e}");
+        }
+    }
 }
