@@ -16,6 +16,7 @@ thread_local dim3 threadIdx, blockIdx, blockDim, gridDim;
 #include "overlap.cuh"
 #include "volume_law.cuh"
 #include "facet.cuh"
+#include "wall_patches.cuh"
 
 #include "integrate.cu"
 #include "list.cu"
@@ -72,6 +73,7 @@ static const Entry kernels[] = {
     KERNEL(pack_states),       KERNEL(unpack_ghost_states), KERNEL(max_records),
     KERNEL(particle_figures),  KERNEL(polyhedron_overlaps),
     KERNEL(polyhedron_contacts), KERNEL(polyhedron_facets),
+    KERNEL(polyhedron_wall_patches),
 };
 
 // The trampoline of the kernel named `name`, or null.

@@ -3,9 +3,10 @@
 // OVERLAP_DOUBLES (volume 0: apart); `polyhedron_contacts`, one thread per
 // candidate pair of particles, the overlap and the volume law's force
 // (volume_law.cuh); `polyhedron_facets`, one thread per particle shape and wall
-// triangle, the overlap with the prism under the triangle (facet.cuh). Compiled
-// after vec.cuh, contact.cuh, triangle.cuh, overlap.cuh, volume_law.cuh and
-// facet.cuh.
+// triangle, the overlap with the prism under the triangle (facet.cuh);
+// `polyhedron_wall_patches`, one thread per particle, its patches against the walls
+// (wall_patches.cuh). Compiled after vec.cuh, contact.cuh, triangle.cuh,
+// overlap.cuh, volume_law.cuh, facet.cuh and wall_patches.cuh.
 
 // A pose of B in A's frame: B's centroid (three doubles), then its orientation
 // (w, x, y, z).
@@ -166,4 +167,64 @@ extern "C" __global__ void polyhedron_facets(
                    load3(triangles, 3 * k + 2)};
     facet_overlap(table, &side, circumradius[shapes[k]], tri, &poly,
                   records + FACET_DOUBLES * k);
+}
+
+// One thread per particle: its patches against every wall, in wall order, each
+// with its facets' shares (wall_patches.cuh; the facets as index within their
+// wall). `overflow` is set where a particle has more patches than PATCH_SLOTS or
+// a patch more facets than SHARE_SLOTS. Per wall, its first facet (walls + 1
+// entries); per facet, its triangle in world coordinates and its unit normal.
+extern "C" __global__ void polyhedron_wall_patches(
+    unsigned n, const double* position, const double* orientation, const unsigned* body_type,
+    const unsigned* type_shape, const unsigned* shape_index, const unsigned* face_span,
+    const unsigned* loops, const Mask* face_masks, const double* vertices, const double* planes,
+    const double* circumradius, unsigned walls, const unsigned* wall_facets,
+    const double* facets, const double* facet_normals, unsigned* patch_count,
+    unsigned* patch_wall, long long* patch_keys, double* patch_geometry,
+    unsigned* patch_shares, unsigned* share_facet, double* share_volume, unsigned* overflow) {
+    unsigned i = blockIdx.x * blockDim.x + threadIdx.x;
+    if (i >= n) {
+        return;
+    }
+    ShapeTable table =
+        ShapeTable{shape_index, face_span, loops, face_masks, vertices, planes, circumradius};
+    unsigned shape = type_shape[body_type[i]];
+    Side side;
+    Polygon poly;
+    Mat3 identity = Mat3{{1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0}};
+    place_side(table, shape, false, identity, Vec3{0.0, 0.0, 0.0}, &side);
+    Vec3 x = load3(position, i);
+    Quat q = load_orientation(orientation, i);
+    unsigned made = 0;
+    for (unsigned w = 0; w < walls; ++w) {
+        Patch patches[PATCH_SLOTS];
+        unsigned count = 0;
+        bool fits = wall_patches(table, &side, circumradius[shape], x, q, wall_facets[w],
+                                 wall_facets[w + 1], facets, facet_normals, &poly, patches,
+                                 &count);
+        if (!fits || made + count > PATCH_SLOTS) {
+            atomicOr(overflow, 1u);
+        }
+        for (unsigned p = 0; p < count && made < PATCH_SLOTS; ++p, ++made) {
+            unsigned slot = PATCH_SLOTS * i + made;
+            const Patch* patch = &patches[p];
+            patch_wall[slot] = w;
+            for (unsigned c = 0; c < 4; ++c) {
+                patch_keys[4 * slot + c] = patch->key[c];
+            }
+            double* g = patch_geometry + PATCH_DOUBLES * slot;
+            g[0] = patch->volume;
+            store3(g + 1, 0, patch->point);
+            store3(g + 4, 0, patch->normal);
+            g[7] = patch->area;
+            g[8] = patch->depth;
+            store3(g + 9, 0, patch->rotation_gradient);
+            patch_shares[slot] = patch->shares;
+            for (unsigned k = 0; k < patch->shares; ++k) {
+                share_facet[SHARE_SLOTS * slot + k] = patch->facet[k] - wall_facets[w];
+                share_volume[SHARE_SLOTS * slot + k] = patch->share[k];
+            }
+        }
+    }
+    patch_count[i] = made;
 }

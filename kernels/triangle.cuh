@@ -1,7 +1,8 @@
-// The point of a triangle closest to a point (geometry/sphere.rs,
-// closest_point_on_triangle: Ericson's Voronoi-region tests), shared by the
-// spheres' wall contacts (walls.cu) and the polyhedra's (facet.cuh). Compiled
-// after vec.cuh.
+// Wall facets as the contacts of spheres (walls.cu) and of polyhedra
+// (facet.cuh, wall_patches.cuh) read them: the point of a triangle closest to a
+// point (geometry/sphere.rs, closest_point_on_triangle: Ericson's Voronoi-region
+// tests) and the key of a facet's plane that patches are merged by. Compiled after
+// vec.cuh.
 
 static __device__ __forceinline__ Vec3 closest_on_triangle(Vec3 a, Vec3 b, Vec3 c, Vec3 p) {
     Vec3 ab = sub(b, a), ac = sub(c, a), ap = sub(p, a);
@@ -34,4 +35,14 @@ static __device__ __forceinline__ Vec3 closest_on_triangle(Vec3 a, Vec3 b, Vec3 
     }
     double denom = 1.0 / (va + vb + vc);
     return add(add(a, scale(ab, vb * denom)), scale(ac, vc * denom));
+}
+
+// The key of a facet's plane for a particle of bounding radius `radius`
+// (engine/cpu/patch.rs, FacetPlane::key).
+static __device__ __forceinline__ void plane_key(Vec3 n, Vec3 point, double radius,
+                                                 long long* key) {
+    key[0] = (long long)round(n.x * 1e9);
+    key[1] = (long long)round(n.y * 1e9);
+    key[2] = (long long)round(n.z * 1e9);
+    key[3] = (long long)round(dot(n, point) / radius * 1e9);
 }

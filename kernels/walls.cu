@@ -56,15 +56,6 @@ static __device__ __forceinline__ bool sphere_facet(const double* t, Vec3 centre
     return true;
 }
 
-// The plane key of engine/cpu/patch.rs `plane_key`.
-static __device__ __forceinline__ void plane_key(Vec3 n, Vec3 point, double radius,
-                                                 long long* key) {
-    key[0] = (long long)round(n.x * 1e9);
-    key[1] = (long long)round(n.y * 1e9);
-    key[2] = (long long)round(n.z * 1e9);
-    key[3] = (long long)round(dot(n, point) / radius * 1e9);
-}
-
 // One thread per particle: its wall contacts (see the file's head), none for a
 // passive one (frozen or a ghost). `overflow` is set when a particle has more
 // than WALL_SLOTS contacts.

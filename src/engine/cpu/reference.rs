@@ -1,12 +1,15 @@
-//! The CPU backend's contact of one pair of particles, whole and alone: what the
-//! other backends' kernels are checked against (`engine/cuda`'s tests).
+//! The CPU backend's contact of one pair of particles, and the wall patches of one
+//! particle, whole and alone: what the other backends' kernels are checked against
+//! (`engine/cuda`'s tests).
 
 use nalgebra::Vector3;
 
-use super::dispatch::pair_geometry;
+use super::dispatch::{facet_geometry, pair_geometry, pose_of};
 use super::forces::{PairResult, pair_force};
+use super::patch::{FacetPlane, Merge, PatchSet};
 use crate::Real;
 use crate::contact::TangentialHistory;
+use crate::engine::cuda::device_wall_patches::WallPatch;
 use crate::engine::laws::ContactLaws;
 use crate::geometry::overlap::OverlapCache;
 use crate::world::World;
@@ -60,4 +63,42 @@ pub(in crate::engine) fn pair_contact(
         history,
         depth,
     }
+}
+
+/// The patches of polyhedron `i` against every wall, as the wall stage assembles
+/// them (`walls.rs`, `particle_contacts`): every facet of each wall in order, those
+/// the centroid lies over within the bounding radius, summed by plane.
+pub(in crate::engine) fn wall_patches(world: &World, i: usize) -> Vec<WallPatch> {
+    let p = &world.particles;
+    let shape = &world.body_types[p.body_type[i] as usize].shape;
+    let (radius, pose) = (shape.circumradius(), pose_of(world, i));
+    let mut found = Vec::new();
+    let mut patches = PatchSet::default();
+    for (w, wall) in world.walls.iter().enumerate() {
+        patches.clear();
+        for f in 0..wall.triangles.len() {
+            let tri = wall.facet_world(f);
+            let n = (tri[1] - tri[0]).cross(&(tri[2] - tri[0])).normalize();
+            let height = n.dot(&(p.position[i] - tri[0]));
+            if !(0.0..=radius).contains(&height) {
+                continue;
+            }
+            if let Some(g) = facet_geometry(shape, &pose, &tri) {
+                let key = FacetPlane::new(&n, &tri[0]).key(radius);
+                patches.add(key, f as u32, g, Merge::Sum);
+            }
+        }
+        found.extend(patches.iter().map(|(key, g, shares)| WallPatch {
+            wall: w as u32,
+            key,
+            volume: g.volume,
+            point: g.point,
+            normal: g.normal,
+            area: g.area,
+            depth: g.depth,
+            rotation_gradient: g.rotation_gradient.expect("a polyhedron's"),
+            shares: shares.to_vec(),
+        }));
+    }
+    found
 }

@@ -39,8 +39,9 @@ const RESULT: usize = 12;
 /// law rows are those of the [`ContactLaws`] they were made from.
 #[derive(Debug, Default)]
 pub struct DeviceBodyTypes {
-    shapes: DeviceShapes,
-    shape: Array<u32>,
+    pub(super) shapes: DeviceShapes,
+    /// Per body type, its shape's index in `shapes`.
+    pub(super) shape: Array<u32>,
     mass: Array<Real>,
     /// Principal moments, three per type.
     inertia: Array<Real>,
@@ -131,11 +132,11 @@ impl DeviceBodyTypes {
 /// body type.
 #[derive(Debug, Default)]
 pub struct DeviceStates {
-    position: Array<Real>,
-    orientation: Array<Real>,
+    pub(super) position: Array<Real>,
+    pub(super) orientation: Array<Real>,
     velocity: Array<Real>,
     angular_momentum: Array<Real>,
-    body_type: Array<u32>,
+    pub(super) body_type: Array<u32>,
 }
 
 impl DeviceStates {
@@ -291,7 +292,3 @@ impl VolumeContacts {
             .collect())
     }
 }
-
-#[cfg(test)]
-#[path = "device_volume_contacts_tests.rs"]
-mod tests;

@@ -19,10 +19,13 @@ mod device_list;
 pub mod device_polyhedra;
 mod device_sums;
 pub mod device_volume_contacts;
+pub mod device_wall_patches;
 mod device_walls;
 pub mod driver;
 pub mod host;
 pub mod nvrtc;
+#[cfg(test)]
+mod polyhedra_tests;
 mod readback;
 pub mod spheres;
 
@@ -80,6 +83,13 @@ pub static FACET: KernelFile = KernelFile {
     headers: &[],
 };
 
+/// A polyhedron's facet overlaps summed into patches by plane.
+pub static WALL_PATCHES: KernelFile = KernelFile {
+    name: "wall_patches.cuh",
+    source: include_str!("../../../kernels/wall_patches.cuh"),
+    headers: &[],
+};
+
 /// The kernel files, each compiled to one module.
 pub static FILES: [KernelFile; 9] = [
     KernelFile {
@@ -125,7 +135,15 @@ pub static FILES: [KernelFile; 9] = [
     KernelFile {
         name: "polyhedra.cu",
         source: include_str!("../../../kernels/polyhedra.cu"),
-        headers: &[&VEC, &CONTACT, &TRIANGLE, &OVERLAP, &VOLUME_LAW, &FACET],
+        headers: &[
+            &VEC,
+            &CONTACT,
+            &TRIANGLE,
+            &OVERLAP,
+            &VOLUME_LAW,
+            &FACET,
+            &WALL_PATCHES,
+        ],
     },
 ];
 
@@ -196,11 +214,13 @@ pub enum Kernel {
     PolyhedronContacts,
     /// The overlap of polyhedra with the prisms under wall facets (`polyhedra.cu`).
     PolyhedronFacets,
+    /// Each polyhedron's patches against the walls (`polyhedra.cu`).
+    PolyhedronWallPatches,
 }
 
 impl Kernel {
     /// Every kernel.
-    pub const ALL: [Kernel; 32] = [
+    pub const ALL: [Kernel; 33] = [
         Kernel::KickDrift,
         Kernel::ClosingKick,
         Kernel::BinParticles,
@@ -233,6 +253,7 @@ impl Kernel {
         Kernel::PolyhedronOverlaps,
         Kernel::PolyhedronContacts,
         Kernel::PolyhedronFacets,
+        Kernel::PolyhedronWallPatches,
     ];
 
     /// Its name in the source (`extern "C"`, so the PTX entry has it too).
@@ -270,6 +291,7 @@ impl Kernel {
             Kernel::PolyhedronOverlaps => "polyhedron_overlaps",
             Kernel::PolyhedronContacts => "polyhedron_contacts",
             Kernel::PolyhedronFacets => "polyhedron_facets",
+            Kernel::PolyhedronWallPatches => "polyhedron_wall_patches",
         }
     }
 
@@ -288,7 +310,7 @@ impl Kernel {
             PairEnergyPartials | SumRecords | MaxRecords => 5,
             PackStates | UnpackGhostStates => 6,
             ParticleFigures => 7,
-            PolyhedronOverlaps | PolyhedronContacts | PolyhedronFacets => 8,
+            PolyhedronOverlaps | PolyhedronContacts | PolyhedronFacets | PolyhedronWallPatches => 8,
         };
         &FILES[index]
     }

@@ -1,17 +1,24 @@
-//! The device's volume-law contacts of polyhedra, run by the host executor, against
-//! the CPU backend's pair stage for the same pairs (`pair_geometry`, `pair_force`).
+//! The device's contacts of polyhedra, run by the host executor, against the CPU
+//! backend's: the volume-law contacts of pairs against its pair stage
+//! (`pair_geometry`, `pair_force`), the patches against walls against its wall
+//! stage's (`facet_geometry` summed by `PatchSet`).
 
 use nalgebra::{Point3, Quaternion, UnitQuaternion, Vector3};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 
-use super::*;
+use super::device_volume_contacts::*;
+use super::device_wall_patches::DeviceWallPatches;
+use crate::Real;
 use crate::contact::Material;
+use crate::contact::TangentialHistory;
 use crate::engine::cpu::reference::pair_contact;
 use crate::engine::cuda::device::HostDevice;
+use crate::engine::laws::ContactLaws;
 use crate::engine::params::{REGULARISATION_LENGTH, RoundLaw};
 use crate::geometry::{Shape, generators};
-use crate::world::BodyType;
+use crate::world::World;
+use crate::world::{BodyType, Wall};
 
 /// A random vector in the cube of half-side `size`.
 fn vector(random: &mut Pcg64, size: Real) -> Vector3<Real> {
@@ -190,4 +197,89 @@ fn volume_contacts_equal_the_cpu_pair_stage() {
         worst[0], worst[1], worst[2], worst[3]
     );
     assert!((600..1400).contains(&touching), "{touching}");
+}
+
+/// A floor of 2 cm squares, two triangles each, and a side wall of two triangles
+/// at `x = SIDE`, both facing the particles.
+fn floor_and_side() -> Vec<Wall> {
+    let (mut vertices, mut triangles) = (Vec::new(), Vec::new());
+    let cells = 6;
+    for j in 0..=cells {
+        for k in 0..=cells {
+            vertices.push(Point3::new(
+                -0.06 + 0.02 * k as Real,
+                -0.06 + 0.02 * j as Real,
+                0.0,
+            ));
+        }
+    }
+    let at = |j: u32, k: u32| j * (cells + 1) + k;
+    for j in 0..cells {
+        for k in 0..cells {
+            triangles.push([at(j, k), at(j, k + 1), at(j + 1, k + 1)]);
+            triangles.push([at(j, k), at(j + 1, k + 1), at(j + 1, k)]);
+        }
+    }
+    let floor = Wall::new("floor", 0, vertices, triangles, 0.01);
+    let side = Wall::new(
+        "side",
+        1,
+        vec![
+            Point3::new(SIDE, -0.06, -0.01),
+            Point3::new(SIDE, 0.06, -0.01),
+            Point3::new(SIDE, 0.06, 0.05),
+            Point3::new(SIDE, -0.06, 0.05),
+        ],
+        vec![[0, 2, 1], [0, 3, 2]],
+        0.01,
+    );
+    vec![floor, side]
+}
+
+/// Where the side wall stands.
+const SIDE: Real = 0.03;
+
+#[test]
+fn wall_patches_are_the_cpu_wall_stages_bit_for_bit() {
+    let mut random = Pcg64::seed_from_u64(11);
+    let (mut world, _) = world_of_pairs(0, &mut random);
+    world.walls = floor_and_side();
+    // Pellets over the floor's grid lines and corners, some against the side wall,
+    // at heights from touching to half a radius deep.
+    let types = world.body_types.len() as u32;
+    for k in 0..600 {
+        let x = random.random_range(-0.05..SIDE - 0.001);
+        let y = random.random_range(-0.05..0.05);
+        let z = random.random_range(0.4 * PELLET..1.1 * PELLET);
+        let p = &mut world.particles;
+        p.push(
+            k % types,
+            Point3::new(x, y, z),
+            rotation(&mut random),
+            k as u64,
+        );
+    }
+    let mut device = HostDevice::new(64);
+    let types = DeviceBodyTypes::upload(&mut device, &world, REGULARISATION_LENGTH).unwrap();
+    let mut states = DeviceStates::default();
+    states.upload(&mut device, &world).unwrap();
+    let mut patches = DeviceWallPatches::default();
+    patches.place_walls(&mut device, &world).unwrap();
+    patches.find(&mut device, &types, &states).unwrap();
+    let found = patches.patches(&device).unwrap();
+    let (mut touching, mut summed, mut sides) = (0, 0, 0);
+    for (i, on_device) in found.iter().enumerate() {
+        let cpu = crate::engine::cpu::reference::wall_patches(&world, i);
+        assert_eq!(&cpu, on_device, "particle {i}");
+        touching += usize::from(!cpu.is_empty());
+        summed += cpu.iter().filter(|p| p.shares.len() > 1).count();
+        sides += cpu.iter().filter(|p| p.wall == 1).count();
+    }
+    eprintln!(
+        "{touching} of 600 pellets touch walls: {summed} patches of several facets, {sides} on the side wall"
+    );
+    assert!(
+        touching > 200 && summed > 50 && sides > 5,
+        "{touching} {summed} {sides}"
+    );
 }
