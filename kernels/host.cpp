@@ -73,7 +73,7 @@ static const Entry kernels[] = {
     KERNEL(pack_states),       KERNEL(unpack_ghost_states), KERNEL(max_records),
     KERNEL(particle_figures),  KERNEL(polyhedron_overlaps),
     KERNEL(polyhedron_contacts), KERNEL(polyhedron_facets),
-    KERNEL(polyhedron_wall_patches),
+    KERNEL(polyhedron_wall_patches), KERNEL(polyhedron_wall_contacts),
 };
 
 // The trampoline of the kernel named `name`, or null.

@@ -5,7 +5,8 @@
 // (volume_law.cuh); `polyhedron_facets`, one thread per particle shape and wall
 // triangle, the overlap with the prism under the triangle (facet.cuh);
 // `polyhedron_wall_patches`, one thread per particle, its patches against the walls
-// (wall_patches.cuh). Compiled after vec.cuh, contact.cuh, triangle.cuh,
+// (wall_patches.cuh); `polyhedron_wall_contacts`, one thread per particle, the
+// volume law's contact of each patch. Compiled after vec.cuh, contact.cuh, triangle.cuh,
 // overlap.cuh, volume_law.cuh, facet.cuh and wall_patches.cuh.
 
 // A pose of B in A's frame: B's centroid (three doubles), then its orientation
@@ -71,9 +72,9 @@ static __device__ double inverse_mass_at(Quat q, Vec3 x, double mass, Vec3 inert
 extern "C" __global__ void polyhedron_contacts(
     unsigned pair_count, double dt, const unsigned* pairs, const double* position,
     const double* orientation, const double* velocity, const double* angular_momentum,
-    const unsigned* body_type, const unsigned* type_shape, const double* type_mass,
-    const double* type_inertia, const unsigned char* type_isotropic, const double* type_law,
-    const unsigned* type_material, unsigned materials, const double* material_law,
+    const unsigned* body_type, const double* type_mass, const double* type_inertia,
+    const unsigned char* type_isotropic, const double* type_law, const unsigned* type_material,
+    unsigned materials, const double* material_law, const unsigned* type_shape,
     const unsigned* shape_index, const unsigned* face_span, const unsigned* loops,
     const Mask* face_masks, const double* vertices, const double* planes,
     const double* circumradius, double* history, double* results) {
@@ -227,4 +228,100 @@ extern "C" __global__ void polyhedron_wall_patches(
         }
     }
     patch_count[i] = made;
+}
+
+// Words of a wall contact's key: the wall, its plane's four numbers.
+#define WALL_KEY_WORDS 5u
+// A wall contact's result: the force on the particle, the torque about its
+// centroid, the elastic energy held, the energy dissipated.
+#define WALL_RESULT_DOUBLES 8u
+
+// One thread per particle: the volume law's contact of each of its wall patches
+// (polyhedron_wall_patches) with an area and a finite normal, its friction spring
+// found among the particle's springs of the step before by wall and plane key
+// (engine/cpu/walls.rs, particle_contacts and patch_force): keys, springs and
+// results into the particle's slots, their count into `count`. Per wall its
+// material and motion (velocity, angular velocity, reference point).
+extern "C" __global__ void polyhedron_wall_contacts(
+    unsigned n, double dt, const double* position, const double* orientation,
+    const double* velocity, const double* angular_momentum, const unsigned* body_type,
+    const double* type_mass, const double* type_inertia, const unsigned char* type_isotropic,
+    const double* type_law, const unsigned* type_material, unsigned materials,
+    const double* material_law, const unsigned* wall_material, const double* wall_motion,
+    const unsigned* patch_count, const unsigned* patch_wall, const long long* patch_keys,
+    const double* patch_geometry, const unsigned* old_count, const long long* old_keys,
+    const double* old_history, unsigned* count, long long* keys, double* history,
+    double* results) {
+    unsigned i = blockIdx.x * blockDim.x + threadIdx.x;
+    if (i >= n) {
+        return;
+    }
+    unsigned t = body_type[i];
+    Vec3 x = load3(position, i), inertia = load3(type_inertia, t);
+    Quat q = load_orientation(orientation, i);
+    Vec3 spin = angular_velocity(q, load3(angular_momentum, i), inertia, type_isotropic[t]);
+    const double* law = type_law + TYPE_LAW_DOUBLES * t;
+    unsigned made = 0;
+    for (unsigned s = 0; s < patch_count[i]; ++s) {
+        unsigned slot = PATCH_SLOTS * i + s;
+        const double* p = patch_geometry + PATCH_DOUBLES * slot;
+        VolumeGeometry g;
+        g.volume = p[0];
+        g.point = load3(p + 1, 0);
+        g.normal = load3(p + 4, 0);
+        g.area = p[7];
+        g.depth = p[8];
+        g.rotation_gradient = load3(p + 9, 0);
+        g.has_gradient = true;
+        bool finite = isfinite(g.normal.x) && isfinite(g.normal.y) && isfinite(g.normal.z);
+        if (!(g.area > 0.0) || !finite) {
+            continue;
+        }
+        unsigned w = patch_wall[slot];
+        const double* wm = wall_motion + 9 * w;
+        const double* m =
+            material_law + MATERIAL_LAW_DOUBLES * (type_material[t] * materials + wall_material[w]);
+        // ContactLaws::wall: the moduli in series over the particle's radius.
+        double normal_stiffness = m[2 + DAMPING_NODES] / law[5];
+        double tangential_stiffness = m[3 + DAMPING_NODES] / law[5];
+        // RelativeMotion::of_wall.
+        VolumeMotion motion;
+        Vec3 at = add(load3(velocity, i), cross(spin, sub(g.point, x)));
+        Vec3 wall_at = add(load3(wm, 0), cross(load3(wm, 1), sub(g.point, load3(wm, 2))));
+        motion.velocity = sub(at, wall_at);
+        motion.spin = sub(spin, load3(wm, 1));
+        motion.inverse_mass = inverse_mass_at(q, x, type_mass[t], inertia, g.point, g.normal);
+        motion.inertia = law[6];
+        // The patch's spring of the last step, found by its key.
+        unsigned out = PATCH_SLOTS * i + made;
+        long long* key = keys + WALL_KEY_WORDS * out;
+        key[0] = w;
+        for (unsigned c = 0; c < 4; ++c) {
+            key[1 + c] = patch_keys[4 * slot + c];
+        }
+        Spring before = Spring{Vec3{0.0, 0.0, 0.0}, 0.0};
+        double twist = 0.0;
+        for (unsigned o = 0; o < old_count[i]; ++o) {
+            const long long* k = old_keys + WALL_KEY_WORDS * (PATCH_SLOTS * i + o);
+            if (k[0] == key[0] && k[1] == key[1] && k[2] == key[2] && k[3] == key[3] &&
+                k[4] == key[4]) {
+                const double* h = old_history + VOLUME_HISTORY_DOUBLES * (PATCH_SLOTS * i + o);
+                before = Spring{load3(h, 0), h[3]};
+                twist = h[4];
+            }
+        }
+        VolumeContact c = volume_contact(g, motion, normal_stiffness, tangential_stiffness,
+                                         law[2], law[3], m, before, twist, dt, x);
+        double* h = history + VOLUME_HISTORY_DOUBLES * out;
+        store3(h, 0, c.kept.spring);
+        h[3] = c.kept.stiffness;
+        h[4] = c.twist;
+        double* r = results + WALL_RESULT_DOUBLES * out;
+        store3(r, 0, c.force);
+        store3(r, 1, c.torque);
+        r[6] = c.energy;
+        r[7] = c.dissipated;
+        ++made;
+    }
+    count[i] = made;
 }

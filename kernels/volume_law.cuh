@@ -11,10 +11,13 @@
 #define DAMPING_P_MAX 5.0
 #define PI_DOUBLE 3.141592653589793
 // A body type's law row: normal and tangential stiffness factors (E/R, G/R), the
-// regularisation volume V₀ and its cube root, the inverse smallest principal moment.
-#define TYPE_LAW_DOUBLES 5u
-// A pair of materials' law row: friction coefficient, restitution, damping nodes.
-#define MATERIAL_LAW_DOUBLES (2u + DAMPING_NODES)
+// regularisation volume V₀ and its cube root, the inverse smallest principal
+// moment, the volume-equivalent radius R, the smallest principal moment.
+#define TYPE_LAW_DOUBLES 7u
+// A pair of materials' law row: friction coefficient, restitution, damping nodes,
+// the moduli in series of a particle against a wall, normal and tangential
+// (engine/laws.rs, ContactLaws::wall).
+#define MATERIAL_LAW_DOUBLES (4u + DAMPING_NODES)
 // A contact's history under the volume law: the friction spring, its stiffness,
 // the twist.
 #define VOLUME_HISTORY_DOUBLES 5u

@@ -43,6 +43,22 @@ pub(super) struct PairLaw {
     pub inertia: Real,
 }
 
+/// One body type's row as a device's volume law reads it (see
+/// [`ContactLaws::type_rows`]).
+#[cfg(feature = "cuda")]
+#[derive(Clone, Copy, Debug)]
+pub(super) struct VolumeTypeRow {
+    /// `E/R` and `G/R`.
+    pub stiffness: PairStiffness,
+    pub regularisation: Regularisation,
+    /// The smallest principal moment, and its inverse.
+    pub inertia: Real,
+    pub inverse_inertia: Real,
+    /// The volume-equivalent radius.
+    pub radius: Real,
+    pub material: usize,
+}
+
 /// One body type's share of its contacts' parameters.
 #[derive(Clone, Copy, Debug)]
 struct TypeRow {
@@ -297,24 +313,29 @@ impl ContactLaws {
     }
 
     /// Per body type, what the device's volume law combines a contact from
-    /// (`kernels/volume_law.cuh`): the stiffness factors, the regularisation, the
-    /// inverse smallest principal moment and the material.
+    /// (`kernels/volume_law.cuh`).
     #[cfg(feature = "cuda")]
-    pub(super) fn type_rows(
-        &self,
-    ) -> impl Iterator<Item = (PairStiffness, Regularisation, Real, usize)> + '_ {
-        self.types
-            .iter()
-            .map(|t| (t.stiffness, t.regularisation, t.inverse_inertia, t.material))
+    pub(super) fn type_rows(&self) -> impl Iterator<Item = VolumeTypeRow> + '_ {
+        self.types.iter().map(|t| VolumeTypeRow {
+            stiffness: t.stiffness,
+            regularisation: t.regularisation,
+            inverse_inertia: t.inverse_inertia,
+            inertia: t.inertia,
+            radius: t.radius,
+            material: t.material,
+        })
     }
 
-    /// Per pair of materials, row-major: the friction coefficient and the damping
-    /// table of the volume law (`None` where no contact follows it).
+    /// Per pair of materials, row-major: the friction coefficient, the damping
+    /// table of the volume law (`None` where no contact follows it) and the moduli
+    /// in series of a particle against a wall.
     #[cfg(feature = "cuda")]
-    pub(super) fn material_rows(&self) -> impl Iterator<Item = (Real, Option<&DampingTable>)> {
+    pub(super) fn material_rows(
+        &self,
+    ) -> impl Iterator<Item = (Real, Option<&DampingTable>, PairStiffness)> {
         self.materials
             .iter()
-            .map(|m| (m.friction, self.tables.get(m.table)))
+            .map(|m| (m.friction, self.tables.get(m.table), m.wall_series))
     }
 
     /// The number of materials the rows are made for.

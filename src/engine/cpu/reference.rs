@@ -4,12 +4,13 @@
 
 use nalgebra::Vector3;
 
-use super::dispatch::{facet_geometry, pair_geometry, pose_of};
+use super::dispatch::{ContactGeometry, facet_geometry, pair_geometry, pose_of};
 use super::forces::{PairResult, pair_force};
 use super::patch::{FacetPlane, Merge, PatchSet};
+use super::walls::patch_force;
 use crate::Real;
 use crate::contact::TangentialHistory;
-use crate::engine::cuda::device_wall_patches::WallPatch;
+use crate::engine::cuda::device_wall_patches::{WallContactResult, WallPatch};
 use crate::engine::laws::ContactLaws;
 use crate::geometry::overlap::OverlapCache;
 use crate::world::World;
@@ -101,4 +102,49 @@ pub(in crate::engine) fn wall_patches(world: &World, i: usize) -> Vec<WallPatch>
         }));
     }
     found
+}
+
+/// The volume law's contacts of polyhedron `i`'s wall patches, as the wall stage
+/// evaluates them (`walls.rs`, `particle_contacts`): each patch with an area and a
+/// finite normal, holding the history `before(wall, key)` gives.
+pub(in crate::engine) fn wall_contacts(
+    world: &World,
+    i: usize,
+    laws: &ContactLaws,
+    dt: Real,
+    before: impl Fn(u32, [i64; 4]) -> TangentialHistory,
+) -> Vec<WallContactResult> {
+    let spin = world.angular_velocity(i);
+    wall_patches(world, i)
+        .into_iter()
+        .filter(|p| p.area > 0.0 && p.normal.iter().all(|x| x.is_finite()))
+        .map(|p| {
+            let g = ContactGeometry {
+                volume: p.volume,
+                area: p.area,
+                depth: p.depth,
+                normal: p.normal,
+                point: p.point,
+                rotation_gradient: Some(p.rotation_gradient),
+            };
+            let c = patch_force(
+                world,
+                (i, &spin),
+                p.wall as usize,
+                &g,
+                before(p.wall, p.key),
+                laws,
+                dt,
+            );
+            WallContactResult {
+                wall: p.wall,
+                key: p.key,
+                force: c.force,
+                torque: c.torque,
+                energy: c.energy,
+                dissipated: c.dissipated,
+                history: c.history,
+            }
+        })
+        .collect()
 }

@@ -11,7 +11,7 @@ use std::ops::Range;
 use nalgebra::{Isometry3, Point3, Vector3};
 use rayon::prelude::*;
 
-use super::dispatch::{facet_geometry, pose_of};
+use super::dispatch::{ContactGeometry, facet_geometry, pose_of};
 use super::forces::{ContactForce, LawInputs, RelativeMotion, contact_force};
 use super::hertz::{HertzInputs, rolling_inertia, round_contact_force};
 use super::pairs::ContactTotals;
@@ -21,6 +21,7 @@ use super::relative_motion::inverse_mass_at;
 use super::type_table::TypeTable;
 use super::wall_history::{WallEntry, WallHistory};
 use crate::Real;
+use crate::contact::TangentialHistory;
 use crate::engine::RoundLaw;
 use crate::engine::backend::WallKey;
 use crate::engine::laws::ContactLaws;
@@ -320,24 +321,22 @@ fn particle_contacts(
             if !(g.area > 0.0) || !g.normal.iter().all(|x| x.is_finite()) {
                 continue;
             }
-            // A sphere's lever to its contact point lies along the normal, so its
-            // effective mass there is its mass: nothing is turned into its body frame.
-            let inverse_mass = sphere.map_or_else(
-                || inverse_mass_at(world, i, &g.point, &g.normal),
-                |s| s.inverse_mass,
-            );
-            let motion = RelativeMotion::of_wall(
-                world,
-                (i, &spin),
-                wall,
-                &g.point,
-                (inverse_mass, law.inertia),
-            );
             let wall_key = (p.id[i], w as u32, key);
             let h =
                 (before.iter().find(|e| e.0 == wall_key)).map_or_else(Default::default, |e| e.1);
             let force = match (round, &t.shape) {
                 (RoundLaw::HertzMindlin { rolling }, Shape::Sphere(s)) => {
+                    let inverse_mass = sphere.map_or_else(
+                        || inverse_mass_at(world, i, &g.point, &g.normal),
+                        |s| s.inverse_mass,
+                    );
+                    let motion = RelativeMotion::of_wall(
+                        world,
+                        (i, &spin),
+                        wall,
+                        &g.point,
+                        (inverse_mass, law.inertia),
+                    );
                     let law = HertzInputs {
                         materials: laws.materials(t.material, wall.material),
                         rolling,
@@ -354,13 +353,7 @@ fn particle_contacts(
                         &h,
                     )
                 }
-                _ => contact_force(
-                    g,
-                    &motion,
-                    &LawInputs::new(laws, &law, dt),
-                    h,
-                    &p.position[i],
-                ),
+                _ => patch_force(world, (i, &spin), w, g, h, laws, dt),
             };
             let start = chunk.shares.len();
             chunk.shares.extend_from_slice(facet_shares);
@@ -373,4 +366,40 @@ fn particle_contacts(
             });
         }
     }
+}
+
+/// The volume law's contact of particle `i` (turning at `spin`) with its patch `g`
+/// on wall `w`, holding history `h`.
+pub(super) fn patch_force(
+    world: &World,
+    (i, spin): (usize, &Vector3<Real>),
+    w: usize,
+    g: &ContactGeometry,
+    h: TangentialHistory,
+    laws: &ContactLaws,
+    dt: Real,
+) -> ContactForce {
+    let p = &world.particles;
+    let wall = &world.walls[w];
+    let law = laws.wall(p.body_type[i], wall.material);
+    // A sphere's lever to its contact point lies along the normal, so its effective
+    // mass there is its mass: nothing is turned into its body frame.
+    let inverse_mass = laws.sphere(p.body_type[i]).map_or_else(
+        || inverse_mass_at(world, i, &g.point, &g.normal),
+        |s| s.inverse_mass,
+    );
+    let motion = RelativeMotion::of_wall(
+        world,
+        (i, spin),
+        wall,
+        &g.point,
+        (inverse_mass, law.inertia),
+    );
+    contact_force(
+        g,
+        &motion,
+        &LawInputs::new(laws, &law, dt),
+        h,
+        &p.position[i],
+    )
 }

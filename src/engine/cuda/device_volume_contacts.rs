@@ -24,9 +24,9 @@ use crate::geometry::{ConvexPolyhedron, is_isotropic};
 use crate::world::World;
 
 /// Doubles of a body type's law row (`TYPE_LAW_DOUBLES` of volume_law.cuh).
-const TYPE_LAW: usize = 5;
+const TYPE_LAW: usize = 7;
 /// Doubles of a pair of materials' law row (`MATERIAL_LAW_DOUBLES`).
-const MATERIAL_LAW: usize = 23;
+const MATERIAL_LAW: usize = 25;
 /// Doubles of a contact's history (`VOLUME_HISTORY_DOUBLES`).
 const HISTORY: usize = 5;
 /// Doubles of a contact's result (`VOLUME_RESULT_DOUBLES` of polyhedra.cu).
@@ -47,13 +47,30 @@ pub struct DeviceBodyTypes {
     inertia: Array<Real>,
     /// 1 where the three moments are equal (`is_isotropic`).
     isotropic: Array<u8>,
+    /// The law rows (`TYPE_LAW_DOUBLES` of volume_law.cuh).
     law: Array<Real>,
     material: Array<u32>,
     material_count: u32,
+    /// Per pair of materials, row-major (`MATERIAL_LAW_DOUBLES`).
     material_law: Array<Real>,
 }
 
 impl DeviceBodyTypes {
+    /// The launch arguments of what the volume law reads of the body types and
+    /// materials: mass, principal moments, isotropy, law rows, material, the
+    /// material count and the material pairs' rows.
+    pub(super) fn law_args(&self) -> [Arg; 7] {
+        [
+            self.mass.arg(),
+            self.inertia.arg(),
+            self.isotropic.arg(),
+            self.law.arg(),
+            self.material.arg(),
+            Arg::U32(self.material_count),
+            self.material_law.arg(),
+        ]
+    }
+
     /// Uploads the body types and materials of `world`, the laws' rows made for
     /// the regularisation length `regularisation_length` (relative to each body's
     /// volume-equivalent radius, as [`crate::engine::params`]' field); body types
@@ -82,21 +99,24 @@ impl DeviceBodyTypes {
         let types = &world.body_types;
         let mut law = Vec::with_capacity(TYPE_LAW * types.len());
         let mut material = Vec::with_capacity(types.len());
-        for (stiffness, regularisation, inverse_inertia, m) in laws.type_rows() {
+        for row in laws.type_rows() {
             law.extend([
-                stiffness.normal,
-                stiffness.tangential,
-                regularisation.volume(),
-                regularisation.cbrt(),
-                inverse_inertia,
+                row.stiffness.normal,
+                row.stiffness.tangential,
+                row.regularisation.volume(),
+                row.regularisation.cbrt(),
+                row.inverse_inertia,
+                row.radius,
+                row.inertia,
             ]);
-            material.push(m as u32);
+            material.push(row.material as u32);
         }
         let mut material_law = Vec::new();
-        for (friction, table) in laws.material_rows() {
+        for (friction, table, wall_series) in laws.material_rows() {
             let table = table.expect("the volume law's damping tables, prepared for polyhedra");
             material_law.extend([friction, table.restitution()]);
             material_law.extend(table.nodes());
+            material_law.extend([wall_series.normal, wall_series.tangential]);
         }
         debug_assert_eq!(
             material_law.len(),
@@ -140,6 +160,18 @@ pub struct DeviceStates {
 }
 
 impl DeviceStates {
+    /// The states as launch arguments: position, orientation, velocity, angular
+    /// momentum, body type.
+    pub(super) fn args(&self) -> [Arg; 5] {
+        [
+            self.position.arg(),
+            self.orientation.arg(),
+            self.velocity.arg(),
+            self.angular_momentum.arg(),
+            self.body_type.arg(),
+        ]
+    }
+
     /// Copies the states of `world`'s particles in.
     pub fn upload(&mut self, device: &mut dyn Device, world: &World) -> Result<(), DeviceError> {
         let p = &world.particles;
@@ -229,24 +261,10 @@ impl VolumeContacts {
         if count == 0 {
             return Ok(());
         }
-        let mut args = vec![
-            Arg::U32(count as u32),
-            Arg::F64(dt),
-            self.pairs.arg(),
-            states.position.arg(),
-            states.orientation.arg(),
-            states.velocity.arg(),
-            states.angular_momentum.arg(),
-            states.body_type.arg(),
-            types.shape.arg(),
-            types.mass.arg(),
-            types.inertia.arg(),
-            types.isotropic.arg(),
-            types.law.arg(),
-            types.material.arg(),
-            Arg::U32(types.material_count),
-            types.material_law.arg(),
-        ];
+        let mut args = vec![Arg::U32(count as u32), Arg::F64(dt), self.pairs.arg()];
+        args.extend(states.args());
+        args.extend(types.law_args());
+        args.push(types.shape.arg());
         args.extend(types.shapes.args());
         args.extend([self.history.arg(), self.results.arg()]);
         // SAFETY: the arrays' invariants and the caller's: two particles per pair,

@@ -216,11 +216,13 @@ pub enum Kernel {
     PolyhedronFacets,
     /// Each polyhedron's patches against the walls (`polyhedra.cu`).
     PolyhedronWallPatches,
+    /// The volume law's contacts of each polyhedron's wall patches (`polyhedra.cu`).
+    PolyhedronWallContacts,
 }
 
 impl Kernel {
     /// Every kernel.
-    pub const ALL: [Kernel; 33] = [
+    pub const ALL: [Kernel; 34] = [
         Kernel::KickDrift,
         Kernel::ClosingKick,
         Kernel::BinParticles,
@@ -254,6 +256,7 @@ impl Kernel {
         Kernel::PolyhedronContacts,
         Kernel::PolyhedronFacets,
         Kernel::PolyhedronWallPatches,
+        Kernel::PolyhedronWallContacts,
     ];
 
     /// Its name in the source (`extern "C"`, so the PTX entry has it too).
@@ -292,6 +295,7 @@ impl Kernel {
             Kernel::PolyhedronContacts => "polyhedron_contacts",
             Kernel::PolyhedronFacets => "polyhedron_facets",
             Kernel::PolyhedronWallPatches => "polyhedron_wall_patches",
+            Kernel::PolyhedronWallContacts => "polyhedron_wall_contacts",
         }
     }
 
@@ -310,7 +314,11 @@ impl Kernel {
             PairEnergyPartials | SumRecords | MaxRecords => 5,
             PackStates | UnpackGhostStates => 6,
             ParticleFigures => 7,
-            PolyhedronOverlaps | PolyhedronContacts | PolyhedronFacets | PolyhedronWallPatches => 8,
+            PolyhedronOverlaps
+            | PolyhedronContacts
+            | PolyhedronFacets
+            | PolyhedronWallPatches
+            | PolyhedronWallContacts => 8,
         };
         &FILES[index]
     }

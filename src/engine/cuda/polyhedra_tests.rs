@@ -8,7 +8,7 @@ use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 
 use super::device_volume_contacts::*;
-use super::device_wall_patches::DeviceWallPatches;
+use super::device_wall_patches::{DeviceWallPatches, PATCH_SLOTS, PolyhedronWallContacts};
 use crate::Real;
 use crate::contact::Material;
 use crate::contact::TangentialHistory;
@@ -239,33 +239,40 @@ fn floor_and_side() -> Vec<Wall> {
 /// Where the side wall stands.
 const SIDE: Real = 0.03;
 
-#[test]
-fn wall_patches_are_the_cpu_wall_stages_bit_for_bit() {
-    let mut random = Pcg64::seed_from_u64(11);
-    let (mut world, _) = world_of_pairs(0, &mut random);
+/// 600 pellets of the five shapes over the floor's grid lines and corners, some
+/// against the side wall, at heights from touching to half a radius deep.
+fn pellets_on_walls(random: &mut Pcg64) -> World {
+    let (mut world, _) = world_of_pairs(0, random);
     world.walls = floor_and_side();
-    // Pellets over the floor's grid lines and corners, some against the side wall,
-    // at heights from touching to half a radius deep.
     let types = world.body_types.len() as u32;
     for k in 0..600 {
         let x = random.random_range(-0.05..SIDE - 0.001);
         let y = random.random_range(-0.05..0.05);
         let z = random.random_range(0.4 * PELLET..1.1 * PELLET);
         let p = &mut world.particles;
-        p.push(
-            k % types,
-            Point3::new(x, y, z),
-            rotation(&mut random),
-            k as u64,
-        );
+        p.push(k % types, Point3::new(x, y, z), rotation(random), k as u64);
+        p.velocity[k as usize] = vector(random, 0.3);
+        p.angular_momentum[k as usize] = vector(random, 1e-8);
     }
+    world
+}
+
+/// The world's body types, states and walls on a host device, and its patches.
+fn on_device(world: &World) -> (HostDevice, DeviceBodyTypes, DeviceStates, DeviceWallPatches) {
     let mut device = HostDevice::new(64);
-    let types = DeviceBodyTypes::upload(&mut device, &world, REGULARISATION_LENGTH).unwrap();
+    let types = DeviceBodyTypes::upload(&mut device, world, REGULARISATION_LENGTH).unwrap();
     let mut states = DeviceStates::default();
-    states.upload(&mut device, &world).unwrap();
+    states.upload(&mut device, world).unwrap();
     let mut patches = DeviceWallPatches::default();
-    patches.place_walls(&mut device, &world).unwrap();
+    patches.place_walls(&mut device, world).unwrap();
     patches.find(&mut device, &types, &states).unwrap();
+    (device, types, states, patches)
+}
+
+#[test]
+fn wall_patches_are_the_cpu_wall_stages_bit_for_bit() {
+    let world = pellets_on_walls(&mut Pcg64::seed_from_u64(11));
+    let (device, _, _, patches) = on_device(&world);
     let found = patches.patches(&device).unwrap();
     let (mut touching, mut summed, mut sides) = (0, 0, 0);
     for (i, on_device) in found.iter().enumerate() {
@@ -276,10 +283,73 @@ fn wall_patches_are_the_cpu_wall_stages_bit_for_bit() {
         sides += cpu.iter().filter(|p| p.wall == 1).count();
     }
     eprintln!(
-        "{touching} of 600 pellets touch walls: {summed} patches of several facets, {sides} on the side wall"
+        "{touching} of 600 pellets touch walls: {summed} patches of several facets, {sides} \
+         on the side wall"
     );
     assert!(
         touching > 200 && summed > 50 && sides > 5,
         "{touching} {summed} {sides}"
     );
+}
+
+#[test]
+fn wall_contacts_are_the_cpu_wall_stages_bit_for_bit() {
+    let mut random = Pcg64::seed_from_u64(13);
+    let world = pellets_on_walls(&mut random);
+    let (mut device, types, states, patches) = on_device(&world);
+    // Springs of the step before: for most patches found, one of random stretch,
+    // stiffness and twist; for some particles a spring of a plane not touched now.
+    let found = patches.patches(&device).unwrap();
+    let held: Vec<Vec<(u32, [i64; 4], TangentialHistory)>> = found
+        .iter()
+        .enumerate()
+        .map(|(i, patches)| {
+            let mut springs = Vec::new();
+            for p in patches {
+                if random.random_range(0.0..1.0) < 0.7 {
+                    let h = TangentialHistory {
+                        spring: vector(&mut random, 2e-5),
+                        stiffness: random.random_range(1e3..3e3),
+                        twist: random.random_range(-0.02..0.02),
+                        ..Default::default()
+                    };
+                    springs.push((p.wall, p.key, h));
+                }
+            }
+            if i % 5 == 0 && springs.len() < PATCH_SLOTS {
+                springs.push((0, [1, 2, 3, 4], TangentialHistory::default()));
+            }
+            springs
+        })
+        .collect();
+    let mut contacts = PolyhedronWallContacts::default();
+    contacts.set_history(&mut device, &held).unwrap();
+    let dt = 2e-6;
+    contacts
+        .evaluate(&mut device, &types, &states, &patches, dt)
+        .unwrap();
+    let results = contacts.results(&device).unwrap();
+    let mut laws = ContactLaws::default();
+    laws.prepare(&world, REGULARISATION_LENGTH, RoundLaw::Volume);
+    let (mut made, mut sliding) = (0, 0);
+    for (i, on_device) in results.iter().enumerate() {
+        let before = |wall: u32, key: [i64; 4]| {
+            held[i]
+                .iter()
+                .find(|h| h.0 == wall && h.1 == key)
+                .map_or_else(TangentialHistory::default, |h| h.2)
+        };
+        let cpu = crate::engine::cpu::reference::wall_contacts(&world, i, &laws, dt, before);
+        assert_eq!(&cpu, on_device, "particle {i}");
+        made += cpu.len();
+        sliding += cpu
+            .iter()
+            .filter(|c| {
+                let h = before(c.wall, c.key);
+                h.stiffness > 0.0 && c.history.spring.norm() < 0.999 * h.spring.norm()
+            })
+            .count();
+    }
+    eprintln!("{made} wall contacts, {sliding} of them shortening their spring (sliding)");
+    assert!(made > 300 && sliding > 10, "{made} {sliding}");
 }
