@@ -2,8 +2,10 @@
 //! `polyhedron_wall_patches` of `kernels/polyhedra.cu`): one thread per particle
 //! finds, wall by wall, the facets it lies over, their overlaps with it, and sums
 //! them by plane into patches, each with its facets' shares, as the CPU backend's
-//! wall stage does for a polyhedron (`engine/cpu/walls.rs`, `engine/cpu/patch.rs`).
-//! The contact law of a patch is the volume law's (`kernels/volume_law.cuh`).
+//! wall stage does for a polyhedron (`engine/cpu/walls.rs`, `engine/cpu/patch.rs`);
+//! [`PolyhedronWallContacts`] then evaluates each patch's contact under the volume
+//! law (`polyhedron_wall_contacts`, `kernels/volume_law.cuh`) with the friction
+//! spring its wall and plane key held the step before.
 
 use nalgebra::{Point3, Vector3};
 
@@ -47,7 +49,7 @@ pub struct WallPatch {
 #[derive(Debug, Default)]
 pub struct DeviceWallPatches {
     walls: u32,
-    /// Per wall its first facet, then the facet count.
+    /// Per wall its first facet, and after the last wall the facet count.
     wall_facets: Array<u32>,
     /// Per facet its triangle (9 doubles) and unit normal (3).
     facets: Array<Real>,
