@@ -30,7 +30,7 @@ static __device__ Vec3 polygon_area_moment(const Vec3* poly, unsigned len) {
     for (unsigned k = 1; k + 1 < len; ++k) {
         Vec3 a = scale(cross(sub(poly[k], p0), sub(poly[k + 1], p0)), 0.5);
         Vec3 sum = add(add(p0, poly[k]), poly[k + 1]);
-        Vec3 centre = Vec3{sum.x / 3.0, sum.y / 3.0, sum.z / 3.0};
+        Vec3 centre = divide(sum, 3.0);
         m = add(m, cross(centre, a));
     }
     return m;
@@ -57,14 +57,7 @@ static __device__ void cone_add_polygon(ConeSums* cone, const Vec3* poly, unsign
 
 static __device__ Vec3 cone_centroid(const ConeSums* cone) {
     double d = 4.0 * cone->volume6;
-    return add(cone->origin,
-               Vec3{cone->moment24.x / d, cone->moment24.y / d, cone->moment24.z / d});
-}
-
-// nalgebra's normalize: each component divided by the norm.
-static __device__ __forceinline__ Vec3 normalize(Vec3 v) {
-    double n = norm(v);
-    return Vec3{v.x / n, v.y / n, v.z / n};
+    return add(cone->origin, divide(cone->moment24, d));
 }
 
 // Whether some vertex of face `f` of `side` lies behind `facet` (wall.rs,
@@ -229,7 +222,7 @@ static __device__ void facet_overlap(const ShapeTable& table, const Side* side,
         if (!any) {
             return;
         }
-        Vec3 mean = Vec3{sum.x / count, sum.y / count, sum.z / count};
+        Vec3 mean = divide(sum, count);
         cone.origin = sub(mean, scale(n, plane_distance(planes[0], mean)));
         // The pieces again, in the same order, for the cones from there.
         prism_pieces(table, side, tri, planes, reach, poly,

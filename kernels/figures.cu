@@ -47,7 +47,7 @@ extern "C" __global__ void particle_figures(
     s[4] = x.y * m;
     s[5] = x.z * m;
     // A sphere's inertia is isotropic: L's frame does not matter.
-    Vec3 w = Vec3{l.x / inertia.x, l.y / inertia.y, l.z / inertia.z};
+    Vec3 w = div3(l, inertia);
     s[6] = 0.5 * m * norm_squared(v) + 0.5 * dot(l, w);
     s[7] = -(m * dot(Vec3{gx, gy, gz}, x));
     e[0] = sqrt(norm_squared(v));

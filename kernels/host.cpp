@@ -12,6 +12,7 @@ thread_local dim3 threadIdx, blockIdx, blockDim, gridDim;
 
 #include "vec.cuh"
 #include "contact.cuh"
+#include "body.cuh"
 #include "triangle.cuh"
 #include "overlap.cuh"
 #include "volume_law.cuh"

@@ -70,8 +70,7 @@ extern "C" __global__ void kick_drift(
     Vec3 v = add(load3(velocity, i), scale(load3(force, i), 0.5 * dt / mass[kind]));
     store3(velocity, i, v);
     store3(position, i, add(load3(position, i), scale(v, dt)));
-    Quat q = Quat{orientation[4 * i + 3], orientation[4 * i], orientation[4 * i + 1],
-                  orientation[4 * i + 2]};
+    Quat q = load_orientation(orientation, i);
     Vec3 l = add(load3(angular_momentum, i), scale(load3(torque, i), 0.5 * dt));
     free_rotation(&q, &l, load3(inertia, kind), dt);
     orientation[4 * i] = q.x;

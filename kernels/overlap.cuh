@@ -99,10 +99,10 @@ struct Side {
     Mask on[MASK_FACES];
 };
 
-// Places shape `shape` in A's frame: turned by `r` and moved by `t` (overlap/mod.rs,
-// point_in_a and plane_in_a); A itself is copied (`turned` false).
-static __device__ void place_side(const ShapeTable& table, unsigned shape, bool turned,
-                                  const Mat3& r, Vec3 t, Side* side) {
+// Places shape `shape` in A's frame: turned by `*r` and moved by `t` (overlap/mod.rs,
+// point_in_a and plane_in_a); with `r` null, as it is in its body frame.
+static __device__ void place_side(const ShapeTable& table, unsigned shape, const Mat3* r, Vec3 t,
+                                  Side* side) {
     unsigned vertex_base = table.index[4 * shape];
     side->vertex_count = table.index[4 * shape + 1];
     side->face_base = table.index[4 * shape + 2];
@@ -110,18 +110,24 @@ static __device__ void place_side(const ShapeTable& table, unsigned shape, bool 
     side->all = first_vertices(side->vertex_count);
     for (unsigned v = 0; v < side->vertex_count; ++v) {
         Vec3 p = load3(table.vertices, vertex_base + v);
-        side->points[v] = turned ? add(mat_vec(r, p), t) : p;
+        side->points[v] = r ? add(mat_vec(*r, p), t) : p;
     }
     for (unsigned f = 0; f < side->face_count; ++f) {
         const double* plane = table.planes + 4 * (side->face_base + f);
         Vec3 normal = Vec3{plane[0], plane[1], plane[2]};
-        if (turned) {
-            normal = mat_vec(r, normal);
+        if (r) {
+            normal = mat_vec(*r, normal);
             side->planes[f] = Plane{normal, plane[3] + dot(normal, t)};
         } else {
             side->planes[f] = Plane{normal, plane[3]};
         }
     }
+}
+
+// Shape `shape` as it is in its body frame.
+static __device__ __forceinline__ void place_body(const ShapeTable& table, unsigned shape,
+                                                  Side* side) {
+    place_side(table, shape, 0, Vec3{0.0, 0.0, 0.0}, side);
 }
 
 // The planes of `side` whose outside the ball (`centre`, `radius`) reaches to within
@@ -338,7 +344,7 @@ static __device__ void add_piece(Pieces* pieces, const Vec3* poly, unsigned len,
     Vec3 weighted = add(spread, scale(p0, 3.0 * twice_area));
     Vec3 area = scale(normal, 0.5 * twice_area);
     Vec3 c = cross(weighted, normal);
-    Vec3 moment = Vec3{c.x / 6.0, c.y / 6.0, c.z / 6.0};
+    Vec3 moment = divide(c, 6.0);
     SideSums* side = of_b ? &pieces->b : &pieces->a;
     if (flush) {
         side->flush_area = add(side->flush_area, area);
@@ -423,8 +429,8 @@ static __device__ void polyhedron_overlap(const ShapeTable& table, unsigned shap
         return;
     }
     Mat3 r = rotation_matrix(q);
-    place_side(table, shape_a, false, r, t, &s->a);
-    place_side(table, shape_b, true, r, t, &s->b);
+    place_body(table, shape_a, &s->a);
+    place_side(table, shape_b, &r, t, &s->b);
     double tol = 1e-12 * fmax(ra, rb);
     s->a.reached = planes_reached(&s->a, t, rb, tol);
     s->b.reached = planes_reached(&s->b, Vec3{0.0, 0.0, 0.0}, ra, tol);
@@ -453,7 +459,7 @@ static __device__ void polyhedron_overlap(const ShapeTable& table, unsigned shap
     Vec3 normal = Vec3{1.0, 0.0, 0.0};
     if (area > 0.0) {
         double d = 2.0 * area;
-        normal = Vec3{twice.x / d, twice.y / d, twice.z / d};
+        normal = divide(twice, d);
     }
     // The largest finite doubles: there is at least one piece.
     lo = 1.7976931348623157e308;
@@ -465,7 +471,7 @@ static __device__ void polyhedron_overlap(const ShapeTable& table, unsigned shap
     }
     double d4 = 4.0 * pieces->surface.volume6;
     Vec3 m = pieces->surface.moment24;
-    Vec3 centroid = add(pieces->surface.apex, Vec3{m.x / d4, m.y / d4, m.z / d4});
+    Vec3 centroid = add(pieces->surface.apex, divide(m, d4));
     Vec3 gradient_b = sub(add(b.moment, a.flush_moment), cross(t, s_b));
     record[0] = volume;
     store3(record + 1, 0, centroid);

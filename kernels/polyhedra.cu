@@ -6,8 +6,8 @@
 // triangle, the overlap with the prism under the triangle (facet.cuh);
 // `polyhedron_wall_patches`, one thread per particle, its patches against the walls
 // (wall_patches.cuh); `polyhedron_wall_contacts`, one thread per particle, the
-// volume law's contact of each patch. Compiled after vec.cuh, contact.cuh, triangle.cuh,
-// overlap.cuh, volume_law.cuh, facet.cuh and wall_patches.cuh.
+// volume law's contact of each patch. Compiled after vec.cuh, contact.cuh, body.cuh,
+// triangle.cuh, overlap.cuh, volume_law.cuh, facet.cuh and wall_patches.cuh.
 
 // A pose of B in A's frame: B's centroid (three doubles), then its orientation
 // (w, x, y, z).
@@ -36,30 +36,6 @@ extern "C" __global__ void polyhedron_overlaps(
 // torque on the first and on the second, the elastic energy held, the energy
 // dissipated, and 1 where the pair touches (0 apart).
 #define VOLUME_RESULT_DOUBLES 12u
-
-// An orientation as nalgebra stores it: i, j, k, w.
-static __device__ __forceinline__ Quat load_orientation(const double* o, unsigned i) {
-    return Quat{o[4 * i + 3], o[4 * i], o[4 * i + 1], o[4 * i + 2]};
-}
-
-// A particle's angular velocity from its angular momentum (world/mod.rs,
-// World::angular_velocity): principal moments `inertia` in the body frame.
-static __device__ Vec3 angular_velocity(Quat q, Vec3 l, Vec3 inertia, bool isotropic) {
-    if (isotropic) {
-        return Vec3{l.x / inertia.x, l.y / inertia.x, l.z / inertia.x};
-    }
-    Vec3 body = rotate(conjugate(q), l);
-    return rotate(q, Vec3{body.x / inertia.x, body.y / inertia.y, body.z / inertia.z});
-}
-
-// The inverse mass of a body at `point` along `n` (engine/cpu/relative_motion.rs,
-// inverse_mass_at).
-static __device__ double inverse_mass_at(Quat q, Vec3 x, double mass, Vec3 inertia, Vec3 point,
-                                         Vec3 n) {
-    Vec3 lever = rotate(conjugate(q), cross(sub(point, x), n));
-    Vec3 spread = Vec3{lever.x / inertia.x, lever.y / inertia.y, lever.z / inertia.z};
-    return 1.0 / mass + dot(spread, lever);
-}
 
 // One thread per candidate pair of polyhedra: the overlap of the two particles'
 // shapes (overlap.cuh) and, where they overlap, their contact under the volume law
@@ -162,8 +138,7 @@ extern "C" __global__ void polyhedron_facets(
         ShapeTable{shape_index, face_span, loops, face_masks, vertices, planes, circumradius};
     Side side;
     Polygon poly;
-    Mat3 identity = Mat3{{1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0}};
-    place_side(table, shapes[k], false, identity, Vec3{0.0, 0.0, 0.0}, &side);
+    place_body(table, shapes[k], &side);
     Vec3 tri[3] = {load3(triangles, 3 * k), load3(triangles, 3 * k + 1),
                    load3(triangles, 3 * k + 2)};
     facet_overlap(table, &side, circumradius[shapes[k]], tri, &poly,
@@ -172,7 +147,7 @@ extern "C" __global__ void polyhedron_facets(
 
 // One thread per particle: its patches against every wall, in wall order, each
 // with its facets' shares (wall_patches.cuh; the facets as index within their
-// wall). `overflow` is set where a particle has more patches than PATCH_SLOTS or
+// wall). `overflow` is set where a particle has more patches than WALL_SLOTS or
 // a patch more facets than SHARE_SLOTS. Per wall, its first facet (walls + 1
 // entries); per facet, its triangle in world coordinates and its unit normal.
 extern "C" __global__ void polyhedron_wall_patches(
@@ -192,22 +167,21 @@ extern "C" __global__ void polyhedron_wall_patches(
     unsigned shape = type_shape[body_type[i]];
     Side side;
     Polygon poly;
-    Mat3 identity = Mat3{{1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0}};
-    place_side(table, shape, false, identity, Vec3{0.0, 0.0, 0.0}, &side);
+    place_body(table, shape, &side);
     Vec3 x = load3(position, i);
     Quat q = load_orientation(orientation, i);
     unsigned made = 0;
     for (unsigned w = 0; w < walls; ++w) {
-        Patch patches[PATCH_SLOTS];
+        Patch patches[WALL_SLOTS];
         unsigned count = 0;
         bool fits = wall_patches(table, &side, circumradius[shape], x, q, wall_facets[w],
                                  wall_facets[w + 1], facets, facet_normals, &poly, patches,
                                  &count);
-        if (!fits || made + count > PATCH_SLOTS) {
+        if (!fits || made + count > WALL_SLOTS) {
             atomicOr(overflow, 1u);
         }
-        for (unsigned p = 0; p < count && made < PATCH_SLOTS; ++p, ++made) {
-            unsigned slot = PATCH_SLOTS * i + made;
+        for (unsigned p = 0; p < count && made < WALL_SLOTS; ++p, ++made) {
+            unsigned slot = WALL_SLOTS * i + made;
             const Patch* patch = &patches[p];
             patch_wall[slot] = w;
             for (unsigned c = 0; c < 4; ++c) {
@@ -230,8 +204,6 @@ extern "C" __global__ void polyhedron_wall_patches(
     patch_count[i] = made;
 }
 
-// Words of a wall contact's key: the wall, its plane's four numbers.
-#define WALL_KEY_WORDS 5u
 // A wall contact's result: the force on the particle, the torque about its
 // centroid, the elastic energy held, the energy dissipated.
 #define WALL_RESULT_DOUBLES 8u
@@ -263,7 +235,7 @@ extern "C" __global__ void polyhedron_wall_contacts(
     const double* law = type_law + TYPE_LAW_DOUBLES * t;
     unsigned made = 0;
     for (unsigned s = 0; s < patch_count[i]; ++s) {
-        unsigned slot = PATCH_SLOTS * i + s;
+        unsigned slot = WALL_SLOTS * i + s;
         const double* p = patch_geometry + PATCH_DOUBLES * slot;
         VolumeGeometry g;
         g.volume = p[0];
@@ -293,22 +265,19 @@ extern "C" __global__ void polyhedron_wall_contacts(
         motion.inverse_mass = inverse_mass_at(q, x, type_mass[t], inertia, g.point, g.normal);
         motion.inertia = law[6];
         // The patch's spring of the last step, found by its key.
-        unsigned out = PATCH_SLOTS * i + made;
-        long long* key = keys + WALL_KEY_WORDS * out;
+        unsigned out = WALL_SLOTS * i + made;
+        long long* key = keys + KEY_WORDS * out;
         key[0] = w;
         for (unsigned c = 0; c < 4; ++c) {
             key[1 + c] = patch_keys[4 * slot + c];
         }
         Spring before = Spring{Vec3{0.0, 0.0, 0.0}, 0.0};
         double twist = 0.0;
-        for (unsigned o = 0; o < old_count[i]; ++o) {
-            const long long* k = old_keys + WALL_KEY_WORDS * (PATCH_SLOTS * i + o);
-            if (k[0] == key[0] && k[1] == key[1] && k[2] == key[2] && k[3] == key[3] &&
-                k[4] == key[4]) {
-                const double* h = old_history + VOLUME_HISTORY_DOUBLES * (PATCH_SLOTS * i + o);
-                before = Spring{load3(h, 0), h[3]};
-                twist = h[4];
-            }
+        unsigned held = held_slot(old_keys + KEY_WORDS * WALL_SLOTS * i, old_count[i], key);
+        if (held < old_count[i]) {
+            const double* h = old_history + VOLUME_HISTORY_DOUBLES * (WALL_SLOTS * i + held);
+            before = Spring{load3(h, 0), h[3]};
+            twist = h[4];
         }
         VolumeContact c = volume_contact(g, motion, normal_stiffness, tangential_stiffness,
                                          law[2], law[3], m, before, twist, dt, x);

@@ -1,8 +1,13 @@
 // Wall facets as the contacts of spheres (walls.cu) and of polyhedra
 // (facet.cuh, wall_patches.cuh) read them: the point of a triangle closest to a
 // point (geometry/sphere.rs, closest_point_on_triangle: Ericson's Voronoi-region
-// tests) and the key of a facet's plane that patches are merged by. Compiled after
-// vec.cuh.
+// tests), the key of a facet's plane that patches are merged by, and the slots of
+// a particle's wall contacts (a key and a spring each). Compiled after vec.cuh.
+
+// Wall contacts (patches) a particle may have at once.
+#define WALL_SLOTS 4u
+// Words of a wall contact's key: the wall, its plane's four numbers.
+#define KEY_WORDS 5u
 
 static __device__ __forceinline__ Vec3 closest_on_triangle(Vec3 a, Vec3 b, Vec3 c, Vec3 p) {
     Vec3 ab = sub(b, a), ac = sub(c, a), ap = sub(p, a);
@@ -45,4 +50,19 @@ static __device__ __forceinline__ void plane_key(Vec3 n, Vec3 point, double radi
     key[1] = (long long)round(n.y * 1e9);
     key[2] = (long long)round(n.z * 1e9);
     key[3] = (long long)round(dot(n, point) / radius * 1e9);
+}
+
+// The slot among `count` keys (KEY_WORDS each, from `keys`) that equals `key`: the
+// last such, or `count` where none does.
+static __device__ __forceinline__ unsigned held_slot(const long long* keys, unsigned count,
+                                                     const long long* key) {
+    unsigned held = count;
+    for (unsigned s = 0; s < count; ++s) {
+        const long long* k = keys + KEY_WORDS * s;
+        if (k[0] == key[0] && k[1] == key[1] && k[2] == key[2] && k[3] == key[3] &&
+            k[4] == key[4]) {
+            held = s;
+        }
+    }
+    return held;
 }

@@ -36,6 +36,16 @@ static __device__ __forceinline__ Vec3 scale(Vec3 a, double s) {
     return Vec3{a.x * s, a.y * s, a.z * s};
 }
 
+// a / s: each component divided (nalgebra's division by a scalar).
+static __device__ __forceinline__ Vec3 divide(Vec3 a, double s) {
+    return Vec3{a.x / s, a.y / s, a.z / s};
+}
+
+// Component by component a / b (nalgebra's component_div).
+static __device__ __forceinline__ Vec3 div3(Vec3 a, Vec3 b) {
+    return Vec3{a.x / b.x, a.y / b.y, a.z / b.z};
+}
+
 static __device__ __forceinline__ Vec3 mul(Vec3 a, Vec3 b) {
     return Vec3{a.x * b.x, a.y * b.y, a.z * b.z};
 }
@@ -54,6 +64,16 @@ static __device__ __forceinline__ double norm_squared(Vec3 a) {
 
 static __device__ __forceinline__ double norm(Vec3 a) {
     return sqrt(norm_squared(a));
+}
+
+// v / |v| (nalgebra's normalize).
+static __device__ __forceinline__ Vec3 normalize(Vec3 v) {
+    return divide(v, norm(v));
+}
+
+// Quaternion i of an array stored as nalgebra stores it: i, j, k, w.
+static __device__ __forceinline__ Quat load_orientation(const double* o, unsigned i) {
+    return Quat{o[4 * i + 3], o[4 * i], o[4 * i + 1], o[4 * i + 2]};
 }
 
 static __device__ __forceinline__ Quat qmul(Quat a, Quat b) {

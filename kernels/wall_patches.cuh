@@ -7,9 +7,8 @@
 // a wall in index order as the CPU's lists hold them. Compiled after vec.cuh,
 // triangle.cuh, overlap.cuh and facet.cuh.
 
-// Patches a particle may have against all walls at once, and facets their shares
-// may name together.
-#define PATCH_SLOTS 4u
+// Facets one patch's shares may name (a particle has at most WALL_SLOTS patches,
+// triangle.cuh).
 #define SHARE_SLOTS 16u
 // A patch's geometry: volume, point, normal, area, depth, rotation gradient.
 #define PATCH_DOUBLES 12u
@@ -32,10 +31,10 @@ static __device__ bool merge_into(Patch* p, unsigned f, double volume, double ar
     }
     double v = p->volume + volume;
     Vec3 weighted = add(scale(p->point, p->volume), scale(point, volume));
-    p->point = Vec3{weighted.x / v, weighted.y / v, weighted.z / v};
+    p->point = divide(weighted, v);
     Vec3 sum = add(scale(p->normal, p->area), scale(normal, area));
     p->area = norm(sum);
-    p->normal = Vec3{sum.x / p->area, sum.y / p->area, sum.z / p->area};
+    p->normal = divide(sum, p->area);
     p->volume = v;
     p->depth = fmax(p->depth, depth);
     p->rotation_gradient = add(p->rotation_gradient, rotation_gradient);
@@ -48,7 +47,7 @@ static __device__ bool merge_into(Patch* p, unsigned f, double volume, double ar
 // The patches of particle `side` (its shape placed in its body frame, bounding
 // radius `radius`, centroid `x`, orientation `q`) against the facets
 // `first..end` of one wall (world triangles, 9 doubles each, and unit normals),
-// into `patches` (`*count` of them, at most PATCH_SLOTS); false where they do not
+// into `patches` (`*count` of them, at most WALL_SLOTS); false where they do not
 // fit.
 static __device__ bool wall_patches(const ShapeTable& table, const Side* side, double radius,
                                     Vec3 x, Quat q, unsigned first, unsigned end,
@@ -74,8 +73,7 @@ static __device__ bool wall_patches(const ShapeTable& table, const Side* side, d
         }
         Vec3 gradient = load3(o + 4, 0);
         double area = norm(gradient);
-        Vec3 turned = scale(rotate(q, gradient), -1.0);
-        Vec3 normal = Vec3{turned.x / area, turned.y / area, turned.z / area};
+        Vec3 normal = divide(scale(rotate(q, gradient), -1.0), area);
         Vec3 point = add(rotate(q, load3(o + 1, 0)), x);
         Vec3 rotation_gradient = rotate(q, load3(o + 7, 0));
         long long key[4];
@@ -92,7 +90,7 @@ static __device__ bool wall_patches(const ShapeTable& table, const Side* side, d
             }
             continue;
         }
-        if (*count == PATCH_SLOTS) {
+        if (*count == WALL_SLOTS) {
             return false;
         }
         Patch* fresh = &patches[(*count)++];

@@ -16,8 +16,6 @@
 // elastic energy and the energy dissipated (9 doubles) and the facet; the count of
 // contacts.
 
-#define WALL_SLOTS 4u
-#define KEY_WORDS 5u
 #define RECORD_DOUBLES 9u
 
 // A sphere's contact with one facet, as geometry/sphere.rs `sphere_triangle`
@@ -38,11 +36,9 @@ static __device__ __forceinline__ bool sphere_facet(const double* t, Vec3 centre
     }
     Vec3 normal;
     if (distance > 0.0) {
-        normal = Vec3{offset.x / distance, offset.y / distance, offset.z / distance};
+        normal = divide(offset, distance);
     } else {
-        Vec3 n = cross(sub(b, a), sub(c, a));
-        double l = norm(n);
-        normal = Vec3{n.x / l, n.y / l, n.z / l};
+        normal = normalize(cross(sub(b, a), sub(c, a)));
     }
     double depth = r - distance;
     const double pi = 3.14159265358979323846;
@@ -83,10 +79,9 @@ extern "C" __global__ void sphere_walls(
     Vec3 x = load3(position, i);
     Vec3 l = load3(angular_momentum, i);
     Vec3 inertia = load3(type_inertia, kind);
-    Quat q = Quat{orientation[4 * i + 3], orientation[4 * i], orientation[4 * i + 1],
-                  orientation[4 * i + 2]};
+    Quat q = load_orientation(orientation, i);
     // World::angular_velocity of an isotropic body: L / I.
-    Vec3 spin = Vec3{l.x / inertia.x, l.y / inertia.x, l.z / inertia.x};
+    Vec3 spin = angular_velocity(q, l, inertia, true);
     Vec3 f = load3(force, i), t = load3(torque, i);
     unsigned made = 0;
     for (unsigned w = 0; w < walls; ++w) {
@@ -152,9 +147,8 @@ extern "C" __global__ void sphere_walls(
             Vec3 at = add(load3(velocity, i), cross(spin, lever));
             Vec3 wall_at = add(wall_velocity, cross(wall_spin, sub(g.point, reference)));
             Vec3 relative = sub(at, wall_at);
-            Vec3 arm = rotate(conjugate(q), cross(lever, g.normal));
-            Vec3 scaled = Vec3{arm.x / inertia.x, arm.y / inertia.y, arm.z / inertia.z};
-            double inverse_mass = 1.0 / type_mass[kind] + dot(scaled, arm);
+            double inverse_mass = inverse_mass_at(q, x, type_mass[kind], inertia, g.point,
+                                                  g.normal);
             // The patch's spring of the last step, found by its key.
             long long* key = keys + KEY_WORDS * (WALL_SLOTS * i + made);
             key[0] = w;
@@ -162,13 +156,10 @@ extern "C" __global__ void sphere_walls(
                 key[1 + c] = patch_key[p][c];
             }
             Spring before = Spring{Vec3{0.0, 0.0, 0.0}, 0.0};
-            for (unsigned s = 0; s < old_count[i]; ++s) {
-                const long long* o = old_keys + KEY_WORDS * (WALL_SLOTS * i + s);
-                if (o[0] == key[0] && o[1] == key[1] && o[2] == key[2] && o[3] == key[3] &&
-                    o[4] == key[4]) {
-                    const double* h = old_springs + HISTORY_DOUBLES * (WALL_SLOTS * i + s);
-                    before = Spring{load3(h, 0), h[3]};
-                }
+            unsigned held = held_slot(old_keys + KEY_WORDS * WALL_SLOTS * i, old_count[i], key);
+            if (held < old_count[i]) {
+                const double* h = old_springs + HISTORY_DOUBLES * (WALL_SLOTS * i + held);
+                before = Spring{load3(h, 0), h[3]};
             }
             RoundContact c = round_contact(g.depth, g.normal, lever, relative,
                                            sub(spin, wall_spin), inverse_mass, r, m, before, dt);
@@ -258,16 +249,7 @@ extern "C" __global__ void wall_energy_terms(unsigned n, const unsigned* count,
     unsigned m = 0;
     for (unsigned s = 0; s < old_count[i]; ++s) {
         const long long* o = old_keys + KEY_WORDS * (WALL_SLOTS * i + s);
-        bool kept = false;
-        for (unsigned t = 0; t < count[i]; ++t) {
-            const long long* k = keys + KEY_WORDS * (WALL_SLOTS * i + t);
-            bool same = true;
-            for (unsigned c = 0; c < KEY_WORDS; ++c) {
-                same = same && o[c] == k[c];
-            }
-            kept = kept || same;
-        }
-        if (kept) {
+        if (held_slot(keys + KEY_WORDS * WALL_SLOTS * i, count[i], o) < count[i]) {
             continue;
         }
         unsigned at = m++;

@@ -16,9 +16,9 @@ use crate::Real;
 use crate::contact::TangentialHistory;
 use crate::world::World;
 
-/// Patches a particle may have against all walls at once (`PATCH_SLOTS` of
-/// wall_patches.cuh).
-pub const PATCH_SLOTS: usize = 4;
+/// Patches a particle may have against all walls at once (`WALL_SLOTS` of
+/// triangle.cuh: the slots of the spheres' wall contacts).
+pub const PATCH_SLOTS: usize = super::device_walls::SLOTS;
 /// Facets one patch may sum (`SHARE_SLOTS`).
 pub const SHARE_SLOTS: usize = 16;
 /// Doubles of a patch's geometry (`PATCH_DOUBLES`).

@@ -19,7 +19,7 @@ use crate::engine::backend::WallKey;
 use crate::engine::cpu::motion::advance_walls;
 use crate::world::World;
 
-/// Contacts a particle may have with the walls at once (`WALL_SLOTS` of walls.cu).
+/// Contacts a particle may have with the walls at once (`WALL_SLOTS` of triangle.cuh).
 pub(super) const SLOTS: usize = 4;
 /// Words of a contact's key: the wall and the plane's four rounded numbers.
 const KEY: usize = 5;

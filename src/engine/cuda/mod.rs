@@ -69,7 +69,14 @@ pub static VOLUME_LAW: KernelFile = KernelFile {
     headers: &[],
 };
 
-/// The point of a triangle closest to a point.
+/// How a rigid body moves at a contact: angular velocity, inverse mass at a point.
+pub static BODY: KernelFile = KernelFile {
+    name: "body.cuh",
+    source: include_str!("../../../kernels/body.cuh"),
+    headers: &[],
+};
+
+/// Wall facets: the closest point, the plane key, the wall contacts' slots.
 pub static TRIANGLE: KernelFile = KernelFile {
     name: "triangle.cuh",
     source: include_str!("../../../kernels/triangle.cuh"),
@@ -115,7 +122,7 @@ pub static FILES: [KernelFile; 9] = [
     KernelFile {
         name: "walls.cu",
         source: include_str!("../../../kernels/walls.cu"),
-        headers: &[&VEC, &CONTACT, &TRIANGLE],
+        headers: &[&VEC, &CONTACT, &BODY, &TRIANGLE],
     },
     KernelFile {
         name: "sums.cu",
@@ -138,6 +145,7 @@ pub static FILES: [KernelFile; 9] = [
         headers: &[
             &VEC,
             &CONTACT,
+            &BODY,
             &TRIANGLE,
             &OVERLAP,
             &VOLUME_LAW,
