@@ -20,6 +20,15 @@
 #define PAIR_ENERGY_DOUBLES 2u
 #define MATERIAL_DOUBLES 5u
 
+// Whether this world counts pair (i, j), i of the smaller id, in its totals
+// (world/particles.rs, Particles::counts_pair): where i is owned, unless i is
+// frozen and j a ghost; where i is a ghost, if i is frozen and j owned.
+static __device__ __forceinline__ bool counts_pair(unsigned char ri, unsigned char rj) {
+    bool frozen_i = (ri & FROZEN_ROLE) != 0;
+    bool ghost_i = (ri & GHOST_ROLE) != 0, ghost_j = (rj & GHOST_ROLE) != 0;
+    return ghost_i ? frozen_i && !ghost_j : !(frozen_i && ghost_j);
+}
+
 // 2 √(5/6), the factor of the damping coefficients.
 #define DAMPING_FACTOR 1.8257418583505537
 

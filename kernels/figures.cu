@@ -19,7 +19,7 @@ static __device__ __forceinline__ bool finite3(Vec3 v) {
 extern "C" __global__ void particle_figures(
     unsigned n, const unsigned char* role, const unsigned* body_type, const double* type_mass,
     const double* type_inertia, double gx, double gy, double gz, const double* position,
-    const double* velocity, const double* angular_momentum, const double* force,
+    const double* orientation, const double* velocity, const double* angular_momentum, const double* force,
     const double* torque, const unsigned long long* id, double* sums, double* extrema) {
     unsigned i = blockIdx.x * blockDim.x + threadIdx.x;
     if (i >= n) {
@@ -46,9 +46,9 @@ extern "C" __global__ void particle_figures(
     s[3] = x.x * m;
     s[4] = x.y * m;
     s[5] = x.z * m;
-    // A sphere's inertia is isotropic: L's frame does not matter.
-    Vec3 w = div3(l, inertia);
-    s[6] = 0.5 * m * norm_squared(v) + 0.5 * dot(l, w);
+    // World::particle_kinetic_energy: L in the body frame, over the principal moments.
+    Vec3 lb = rotate(conjugate(load_orientation(orientation, i)), l);
+    s[6] = 0.5 * m * norm_squared(v) + 0.5 * dot(lb, div3(lb, inertia));
     s[7] = -(m * dot(Vec3{gx, gy, gz}, x));
     e[0] = sqrt(norm_squared(v));
     e[1] = x.x;

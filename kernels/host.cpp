@@ -75,6 +75,7 @@ static const Entry kernels[] = {
     KERNEL(particle_figures),  KERNEL(polyhedron_overlaps),
     KERNEL(polyhedron_contacts), KERNEL(polyhedron_facets),
     KERNEL(polyhedron_wall_patches), KERNEL(polyhedron_wall_contacts),
+    KERNEL(polyhedron_wall_sum_rows),
 };
 
 // The trampoline of the kernel named `name`, or null.

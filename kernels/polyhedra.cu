@@ -6,7 +6,8 @@
 // triangle, the overlap with the prism under the triangle (facet.cuh);
 // `polyhedron_wall_patches`, one thread per particle, its patches against the walls
 // (wall_patches.cuh); `polyhedron_wall_contacts`, one thread per particle, the
-// volume law's contact of each patch. Compiled after vec.cuh, contact.cuh, body.cuh,
+// volume law's contact of each patch; `polyhedron_wall_sum_rows`, what they push on
+// the walls and their facets. Compiled after vec.cuh, contact.cuh, body.cuh,
 // triangle.cuh, overlap.cuh, volume_law.cuh, facet.cuh and wall_patches.cuh.
 
 // A pose of B in A's frame: B's centroid (three doubles), then its orientation
@@ -32,28 +33,26 @@ extern "C" __global__ void polyhedron_overlaps(
                        records + OVERLAP_DOUBLES * k);
 }
 
-// A contact's result under the volume law: the force on the second particle, the
-// torque on the first and on the second, the elastic energy held, the energy
-// dissipated, and 1 where the pair touches (0 apart).
-#define VOLUME_RESULT_DOUBLES 12u
-
-// One thread per candidate pair of polyhedra: the overlap of the two particles'
-// shapes (overlap.cuh) and, where they overlap, their contact under the volume law
-// (volume_law.cuh) into its result, its history replaced by what the contact
-// leaves; apart, a zero result and history, and the friction spring's energy as
-// dissipated (engine/cpu/pairs.rs, engine/cpu/dispatch.rs pair_geometry,
-// engine/cpu/forces.rs pair_force). Per body type: its shape, mass, principal
-// moments, whether they are equal, its law row (volume_law.cuh) and material; per
-// pair of materials (row-major) its law row.
+// One thread per candidate pair of polyhedra: where one of the two moves here
+// (is neither frozen nor a ghost), the overlap of their shapes (overlap.cuh) and,
+// where they overlap, their contact under the volume law (volume_law.cuh) into its
+// result, its history replaced by what the contact leaves; apart, a zero result and
+// history, and the friction spring's energy as dissipated (engine/cpu/pairs.rs,
+// engine/cpu/dispatch.rs pair_geometry, engine/cpu/forces.rs pair_force). The
+// result, energy terms and byte are spheres.cu's (the gather and the sums read both
+// alike). Per body type: its shape, mass, principal moments, whether they are
+// equal, its law row (volume_law.cuh) and material; per pair of materials
+// (row-major) its law row.
 extern "C" __global__ void polyhedron_contacts(
     unsigned pair_count, double dt, const unsigned* pairs, const double* position,
     const double* orientation, const double* velocity, const double* angular_momentum,
-    const unsigned* body_type, const double* type_mass, const double* type_inertia,
-    const unsigned char* type_isotropic, const double* type_law, const unsigned* type_material,
-    unsigned materials, const double* material_law, const unsigned* type_shape,
-    const unsigned* shape_index, const unsigned* face_span, const unsigned* loops,
-    const Mask* face_masks, const double* vertices, const double* planes,
-    const double* circumradius, double* history, double* results) {
+    const unsigned* body_type, const unsigned char* role, const double* type_mass,
+    const double* type_inertia, const unsigned char* type_isotropic, const double* type_law,
+    const unsigned* type_material, unsigned materials, const double* material_law,
+    const unsigned* type_shape, const unsigned* shape_index, const unsigned* face_span,
+    const unsigned* loops, const Mask* face_masks, const double* vertices, const double* planes,
+    const double* circumradius, double* history, double* results, double* energies,
+    unsigned char* touching) {
     unsigned e = blockIdx.x * blockDim.x + threadIdx.x;
     if (e >= pair_count) {
         return;
@@ -68,17 +67,26 @@ extern "C" __global__ void polyhedron_contacts(
     Quat inverse = conjugate(qi);
     Vec3 t = add(rotate(inverse, scale(xi, -1.0)), rotate(inverse, xj));
     double* h = history + VOLUME_HISTORY_DOUBLES * e;
-    double* result = results + VOLUME_RESULT_DOUBLES * e;
-    OverlapScratch scratch;
+    double* result = results + RESULT_DOUBLES * e;
+    double* energy = energies + PAIR_ENERGY_DOUBLES * e;
+    bool counted = counts_pair(role[i], role[j]);
+    unsigned char counted_flag = counted ? PAIR_COUNTED : 0u;
     double o[OVERLAP_DOUBLES];
-    polyhedron_overlap(table, type_shape[ti], type_shape[tj], t, qmul(inverse, qj), &scratch, o);
+    o[0] = 0.0;
+    if (!(role[i] && role[j])) {
+        OverlapScratch scratch;
+        polyhedron_overlap(table, type_shape[ti], type_shape[tj], t, qmul(inverse, qj), &scratch,
+                           o);
+    }
     Spring before = Spring{load3(h, 0), h[3]};
     if (!(o[0] > 0.0)) {
-        for (unsigned k = 0; k < VOLUME_RESULT_DOUBLES; ++k) {
+        for (unsigned k = 0; k < RESULT_DOUBLES; ++k) {
             result[k] = 0.0;
         }
         // The friction spring's energy is let go with the contact.
-        result[10] = spring_energy(before);
+        energy[0] = 0.0;
+        energy[1] = counted ? spring_energy(before) : 0.0;
+        touching[e] = counted_flag;
         for (unsigned k = 0; k < VOLUME_HISTORY_DOUBLES; ++k) {
             h[k] = 0.0;
         }
@@ -114,9 +122,9 @@ extern "C" __global__ void polyhedron_contacts(
     store3(result, 0, c.force);
     store3(result, 1, reaction);
     store3(result, 2, c.torque);
-    result[9] = c.energy;
-    result[10] = c.dissipated;
-    result[11] = 1.0;
+    energy[0] = counted ? c.energy : 0.0;
+    energy[1] = counted ? c.dissipated : 0.0;
+    touching[e] = PAIR_TOUCHES | counted_flag;
     store3(h, 0, c.kept.spring);
     h[3] = c.kept.stiffness;
     h[4] = c.twist;
@@ -147,12 +155,13 @@ extern "C" __global__ void polyhedron_facets(
 
 // One thread per particle: its patches against every wall, in wall order, each
 // with its facets' shares (wall_patches.cuh; the facets as index within their
-// wall). `overflow` is set where a particle has more patches than WALL_SLOTS or
-// a patch more facets than SHARE_SLOTS. Per wall, its first facet (walls + 1
-// entries); per facet, its triangle in world coordinates and its unit normal.
+// wall); none for a particle nobody here moves (frozen or a ghost). `overflow` is
+// set where a particle has more patches than WALL_SLOTS or a patch more facets
+// than SHARE_SLOTS. Per wall, its first facet (walls + 1 entries); per facet, its
+// triangle in world coordinates and its unit normal.
 extern "C" __global__ void polyhedron_wall_patches(
     unsigned n, const double* position, const double* orientation, const unsigned* body_type,
-    const unsigned* type_shape, const unsigned* shape_index, const unsigned* face_span,
+    const unsigned char* role, const unsigned* type_shape, const unsigned* shape_index, const unsigned* face_span,
     const unsigned* loops, const Mask* face_masks, const double* vertices, const double* planes,
     const double* circumradius, unsigned walls, const unsigned* wall_facets,
     const double* facets, const double* facet_normals, unsigned* patch_count,
@@ -160,6 +169,10 @@ extern "C" __global__ void polyhedron_wall_patches(
     unsigned* patch_shares, unsigned* share_facet, double* share_volume, unsigned* overflow) {
     unsigned i = blockIdx.x * blockDim.x + threadIdx.x;
     if (i >= n) {
+        return;
+    }
+    patch_count[i] = 0;
+    if (role[i]) {
         return;
     }
     ShapeTable table =
@@ -204,16 +217,14 @@ extern "C" __global__ void polyhedron_wall_patches(
     patch_count[i] = made;
 }
 
-// A wall contact's result: the force on the particle, the torque about its
-// centroid, the elastic energy held, the energy dissipated.
-#define WALL_RESULT_DOUBLES 8u
-
 // One thread per particle: the volume law's contact of each of its wall patches
 // (polyhedron_wall_patches) with an area and a finite normal, its friction spring
-// found among the particle's springs of the step before by wall and plane key
-// (engine/cpu/walls.rs, particle_contacts and patch_force): keys, springs and
-// results into the particle's slots, their count into `count`. Per wall its
-// material and motion (velocity, angular velocity, reference point).
+// found among the particle's springs of the step before by wall and plane key,
+// added to the particle's force and torque in wall and patch order after the
+// pairs' gather (engine/cpu/walls.rs, particle_contacts and patch_force): keys,
+// springs, records (triangle.cuh) and each contact's patch slot into the
+// particle's slots, their count into `count`. Per wall its material and motion
+// (velocity, angular velocity, reference point).
 extern "C" __global__ void polyhedron_wall_contacts(
     unsigned n, double dt, const double* position, const double* orientation,
     const double* velocity, const double* angular_momentum, const unsigned* body_type,
@@ -221,9 +232,10 @@ extern "C" __global__ void polyhedron_wall_contacts(
     const double* type_law, const unsigned* type_material, unsigned materials,
     const double* material_law, const unsigned* wall_material, const double* wall_motion,
     const unsigned* patch_count, const unsigned* patch_wall, const long long* patch_keys,
-    const double* patch_geometry, const unsigned* old_count, const long long* old_keys,
-    const double* old_history, unsigned* count, long long* keys, double* history,
-    double* results) {
+    const double* patch_geometry, const unsigned* patch_shares, const double* share_volume,
+    const unsigned* old_count, const long long* old_keys, const double* old_history,
+    unsigned* count, long long* keys, double* history, double* records, unsigned* record_patch,
+    double* force, double* torque, unsigned char* touching) {
     unsigned i = blockIdx.x * blockDim.x + threadIdx.x;
     if (i >= n) {
         return;
@@ -233,6 +245,7 @@ extern "C" __global__ void polyhedron_wall_contacts(
     Quat q = load_orientation(orientation, i);
     Vec3 spin = angular_velocity(q, load3(angular_momentum, i), inertia, type_isotropic[t]);
     const double* law = type_law + TYPE_LAW_DOUBLES * t;
+    Vec3 f = load3(force, i), tq = load3(torque, i);
     unsigned made = 0;
     for (unsigned s = 0; s < patch_count[i]; ++s) {
         unsigned slot = WALL_SLOTS * i + s;
@@ -285,12 +298,65 @@ extern "C" __global__ void polyhedron_wall_contacts(
         store3(h, 0, c.kept.spring);
         h[3] = c.kept.stiffness;
         h[4] = c.twist;
-        double* r = results + WALL_RESULT_DOUBLES * out;
+        // The facets' total share (a serial sum, as the CPU's).
+        double total = 0.0;
+        for (unsigned k = 0; k < patch_shares[slot]; ++k) {
+            total += share_volume[SHARE_SLOTS * slot + k];
+        }
+        double* r = records + WALL_RECORD_DOUBLES * out;
         store3(r, 0, c.force);
         store3(r, 1, c.torque);
-        r[6] = c.energy;
-        r[7] = c.dissipated;
+        r[6] = total;
+        r[7] = c.energy;
+        r[8] = c.dissipated;
+        record_patch[out] = slot;
+        f = add(f, c.force);
+        tq = add(tq, c.torque);
+        touching[i] = 1;
         ++made;
     }
     count[i] = made;
+    store3(force, i, f);
+    store3(torque, i, tq);
+}
+
+// The walls' sums of polyhedra, first pass (walls.cu's wall_sum_rows, which
+// sums.cu folds on): thread t of `groups` adds the wall contacts of particles t,
+// t + groups, … in that order into row t of `rows`: per wall its force and torque
+// about its reference point (6 doubles), then per facet its force (3 doubles), each
+// of a patch's facets its share of the patch's force.
+extern "C" __global__ void polyhedron_wall_sum_rows(
+    unsigned n, const double* position, unsigned walls, const unsigned* wall_facets,
+    const double* wall_motion, const unsigned* count, const long long* keys,
+    const double* records, const unsigned* record_patch, const unsigned* patch_shares,
+    const unsigned* share_facet, const double* share_volume, unsigned groups, double* rows) {
+    unsigned t = blockIdx.x * blockDim.x + threadIdx.x;
+    if (t >= groups) {
+        return;
+    }
+    unsigned width = 6 * walls + 3 * wall_facets[walls];
+    double* row = rows + (size_t)width * t;
+    for (unsigned k = 0; k < width; ++k) {
+        row[k] = 0.0;
+    }
+    for (unsigned i = t; i < n; i += groups) {
+        Vec3 x = load3(position, i);
+        for (unsigned s = 0; s < count[i]; ++s) {
+            unsigned slot = WALL_SLOTS * i + s;
+            unsigned w = (unsigned)keys[KEY_WORDS * slot];
+            const double* record = records + WALL_RECORD_DOUBLES * slot;
+            Vec3 f = load3(record, 0);
+            add_wall_reaction(row, w, x, load3(wall_motion + 9 * w, 2), f, load3(record, 1));
+            double total = record[6];
+            if (!(total > 0.0)) {
+                continue;
+            }
+            unsigned patch = record_patch[slot];
+            for (unsigned k = 0; k < patch_shares[patch]; ++k) {
+                unsigned facet = 2 * walls + wall_facets[w] + share_facet[SHARE_SLOTS * patch + k];
+                double share = share_volume[SHARE_SLOTS * patch + k];
+                store3(row, facet, sub(load3(row, facet), scale(f, share / total)));
+            }
+        }
+    }
 }

@@ -12,15 +12,6 @@
 // does not count the pair) and its byte (contact.cuh: touches, counted). Per
 // particle its role (contact.cuh: frozen, ghost).
 
-// Whether this world counts pair (i, j), i of the smaller id, in its totals
-// (world/particles.rs, Particles::counts_pair): where i is owned, unless i is
-// frozen and j a ghost; where i is a ghost, if i is frozen and j owned.
-static __device__ __forceinline__ bool counts_pair(unsigned char ri, unsigned char rj) {
-    bool frozen_i = (ri & FROZEN_ROLE) != 0;
-    bool ghost_i = (ri & GHOST_ROLE) != 0, ghost_j = (rj & GHOST_ROLE) != 0;
-    return ghost_i ? frozen_i && !ghost_j : !(frozen_i && ghost_j);
-}
-
 // One thread per candidate pair: its contact, if the spheres overlap and one of
 // them moves here (is neither frozen nor a ghost), into its result; its history
 // replaced by what the contact leaves (none when apart).

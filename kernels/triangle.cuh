@@ -1,13 +1,18 @@
 // Wall facets as the contacts of spheres (walls.cu) and of polyhedra
 // (facet.cuh, wall_patches.cuh) read them: the point of a triangle closest to a
 // point (geometry/sphere.rs, closest_point_on_triangle: Ericson's Voronoi-region
-// tests), the key of a facet's plane that patches are merged by, and the slots of
-// a particle's wall contacts (a key and a spring each). Compiled after vec.cuh.
+// tests), the key of a facet's plane that patches are merged by, the slots of a
+// particle's wall contacts (a key, a spring and a record each) and what a
+// contact pushes on its wall. Compiled after vec.cuh.
 
 // Wall contacts (patches) a particle may have at once.
 #define WALL_SLOTS 4u
 // Words of a wall contact's key: the wall, its plane's four numbers.
 #define KEY_WORDS 5u
+// Doubles of a wall contact's record for the sums: the force on the particle, the
+// torque about its centroid, the facets' total share, the elastic energy held and
+// the energy dissipated.
+#define WALL_RECORD_DOUBLES 9u
 
 static __device__ __forceinline__ Vec3 closest_on_triangle(Vec3 a, Vec3 b, Vec3 c, Vec3 p) {
     Vec3 ab = sub(b, a), ac = sub(c, a), ap = sub(p, a);
@@ -65,4 +70,15 @@ static __device__ __forceinline__ unsigned held_slot(const long long* keys, unsi
         }
     }
     return held;
+}
+
+// Adds to a row of the walls' sums (per wall its force and torque about its
+// reference point, 2 vectors, from vector 0) what a contact of force `f` and
+// torque `torque` on a particle at `x` pushes on wall `w` (engine/cpu/walls.rs:
+// the opposite force, ContactForce::reaction_torque).
+static __device__ __forceinline__ void add_wall_reaction(double* row, unsigned w, Vec3 x,
+                                                         Vec3 reference, Vec3 f, Vec3 torque) {
+    store3(row, 2 * w, sub(load3(row, 2 * w), f));
+    Vec3 reaction = scale(add(torque, cross(sub(x, reference), f)), -1.0);
+    store3(row, 2 * w + 1, add(load3(row, 2 * w + 1), reaction));
 }

@@ -16,8 +16,6 @@
 // elastic energy and the energy dissipated (9 doubles) and the facet; the count of
 // contacts.
 
-#define RECORD_DOUBLES 9u
-
 // A sphere's contact with one facet, as geometry/sphere.rs `sphere_triangle`
 // and engine/cpu/dispatch.rs give it.
 struct FacetContact {
@@ -166,7 +164,7 @@ extern "C" __global__ void sphere_walls(
             double* h = springs + HISTORY_DOUBLES * (WALL_SLOTS * i + made);
             store3(h, 0, c.kept.spring);
             h[3] = c.kept.stiffness;
-            double* record = records + RECORD_DOUBLES * (WALL_SLOTS * i + made);
+            double* record = records + WALL_RECORD_DOUBLES * (WALL_SLOTS * i + made);
             store3(record, 0, c.force);
             store3(record, 1, c.torque);
             record[6] = patch_share[p];
@@ -207,12 +205,9 @@ extern "C" __global__ void wall_sum_rows(unsigned n, const double* position, uns
         for (unsigned s = 0; s < count[i]; ++s) {
             unsigned slot = WALL_SLOTS * i + s;
             unsigned w = (unsigned)keys[KEY_WORDS * slot];
-            const double* record = records + RECORD_DOUBLES * slot;
+            const double* record = records + WALL_RECORD_DOUBLES * slot;
             Vec3 f = load3(record, 0), torque = load3(record, 1);
-            Vec3 reference = load3(wall_motion + 9 * w, 2);
-            store3(row, 2 * w, sub(load3(row, 2 * w), f));
-            Vec3 reaction = scale(add(torque, cross(sub(x, reference), f)), -1.0);
-            store3(row, 2 * w + 1, add(load3(row, 2 * w + 1), reaction));
+            add_wall_reaction(row, w, x, load3(wall_motion + 9 * w, 2), f, torque);
             double share = record[6];
             if (share > 0.0) {
                 unsigned facet = 2 * walls + record_facet[slot];
@@ -227,12 +222,14 @@ extern "C" __global__ void wall_sum_rows(unsigned n, const double* position, uns
 // (in a slot of the last step, not in this one's; in the order of their keys), and
 // their count, as record `first + i` of `terms` (ENERGY_RECORD doubles, summed by
 // sums.cu). The CPU backend's terms (engine/cpu/walls.rs), the ended springs in its
-// order.
+// order. A slot's history is `history_doubles` long, the spring first (spheres' and
+// polyhedra's contacts alike).
 extern "C" __global__ void wall_energy_terms(unsigned n, const unsigned* count,
                                              const long long* keys, const double* records,
                                              const unsigned* old_count,
                                              const long long* old_keys,
-                                             const double* old_springs, unsigned first,
+                                             const double* old_springs,
+                                             unsigned history_doubles, unsigned first,
                                              double* terms) {
     unsigned i = blockIdx.x * blockDim.x + threadIdx.x;
     if (i >= n) {
@@ -240,7 +237,7 @@ extern "C" __global__ void wall_energy_terms(unsigned n, const unsigned* count,
     }
     double energy = 0.0, dissipated = 0.0;
     for (unsigned s = 0; s < count[i]; ++s) {
-        const double* record = records + RECORD_DOUBLES * (WALL_SLOTS * i + s);
+        const double* record = records + WALL_RECORD_DOUBLES * (WALL_SLOTS * i + s);
         energy += record[7];
         dissipated += record[8];
     }
@@ -267,7 +264,7 @@ extern "C" __global__ void wall_energy_terms(unsigned n, const unsigned* count,
         order[at] = s;
     }
     for (unsigned k = 0; k < m; ++k) {
-        const double* h = old_springs + HISTORY_DOUBLES * (WALL_SLOTS * i + order[k]);
+        const double* h = old_springs + history_doubles * (WALL_SLOTS * i + order[k]);
         dissipated += spring_energy(Spring{load3(h, 0), h[3]});
     }
     double* record = terms + ENERGY_RECORD * (first + i);

@@ -166,13 +166,25 @@ fn a_scene_asking_for_the_cuda_backend_is_checked_when_read() {
              other than Hertz–Mindlin without rolling resistance"
         )
     );
+    // Polyhedra are stepped (under the volume law), a mix of spheres and polyhedra
+    // not yet.
     let rocks = cuda.replace(
         "kind = \"sphere\"\nradius = 0.004",
         "kind = \"platonic\"\nsolid = \"dodecahedron\"\ncircumradius = 0.004",
     );
-    let e = Scene::parse(&rocks, Path::new("pour.toml")).unwrap_err();
+    match Scene::parse(&rocks, Path::new("pour.toml")) {
+        Ok(_) => assert!(talus::engine::cuda::driver::CudaDevice::is_present()),
+        Err(e) => assert!(e.to_string().contains("no CUDA driver"), "{e}"),
+    }
+    let mixed = cuda.replace(
+        "[[wall]]",
+        "[shapes.rock]\nkind = \"platonic\"\nsolid = \"cube\"\ncircumradius = 0.004\n[[wall]]",
+    );
+    let mixed = mixed.replace("[[inlet]]\nshape = \"bead\"", "[[inlet]]\nshape = \"rock\"");
+    let e = Scene::parse(&mixed, Path::new("pour.toml")).unwrap_err();
     assert!(
-        e.to_string().ends_with("does not yet step polyhedra"),
+        e.to_string()
+            .ends_with("does not yet step a mix of spheres and polyhedra"),
         "{e}"
     );
     // The CPU backend stays the default.

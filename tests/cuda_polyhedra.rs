@@ -5,12 +5,16 @@
 //! random poses (where the CPU evaluates a kept topology, the kernel clips the
 //! faces), and bit for bit where the CPU clips too (flush faces); and the overlap
 //! of a shape with the prism under a wall facet against the CPU's
-//! ([`talus::geometry::wall::polyhedron_triangle`]), bit for bit.
+//! ([`talus::geometry::wall::polyhedron_triangle`]), bit for bit. Then a pour of
+//! polyhedra stepped by the CUDA backend against the CPU backend.
 #![cfg(feature = "cuda")]
+
+use std::path::Path;
 
 use nalgebra::{Isometry3, Point3, Quaternion, Translation3, UnitQuaternion, Vector3};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
+use talus::engine::cuda::backend::CudaBackend;
 use talus::engine::cuda::device::{Device, HostDevice};
 use talus::engine::cuda::device_polyhedra::{
     DeviceShapes, FacetQueries, PolyhedronPairs, ShapeTableError,
@@ -19,6 +23,10 @@ use talus::engine::cuda::driver::CudaDevice;
 use talus::geometry::overlap::{OverlapGeometry, overlap};
 use talus::geometry::wall::polyhedron_triangle;
 use talus::geometry::{ConvexPolyhedron, Pose, generators};
+use talus::scene::{Scene, Simulation};
+use talus::world::World;
+
+const ROCKS: &str = include_str!("scenes/rock_pour.toml");
 
 /// A random orientation, uniform over the turns.
 fn rotation(random: &mut Pcg64) -> UnitQuaternion<f64> {
@@ -279,4 +287,93 @@ fn on_a_gpu_overlaps_and_facet_overlaps_are_the_cpus() {
             eprintln!("skipped: {e}");
         }
     }
+}
+
+/// A pour of cubes onto a lattice of dodecahedra in a box, stepped by the CPU
+/// backend and by the CUDA backend through the host executor for 1000 steps:
+/// the same contacts at every hundredth step, and the particles, the box's force
+/// and the contacts' energies to round-off carried on by the bed. The kernel clips
+/// the faces afresh where the CPU evaluates a kept topology, so the overlaps differ
+/// by round-off, and every impact amplifies a difference: the CPU backend against
+/// itself with every particle nudged by one unit in the last place drifts as far.
+#[test]
+fn a_pour_of_polyhedra_runs_as_on_the_cpu_backend_to_round_off() {
+    let scene = Scene::parse(ROCKS, Path::new("rock_pour.toml")).unwrap();
+    let mut cpu = Simulation::new(&scene);
+    let device = Box::new(HostDevice::new(64));
+    let backend = CudaBackend::new(device, &scene.world, scene.step_params()).unwrap();
+    let mut gpu = Simulation::with_backend(&scene, Box::new(backend));
+    let mut nudged_scene = scene.clone();
+    for x in &mut nudged_scene.world.particles.position {
+        x.x = f64::from_bits(x.x.to_bits() + 1);
+    }
+    let mut nudged = Simulation::new(&nudged_scene);
+    // The largest differences from the CPU backend of the device (0) and of the
+    // nudged CPU run (1): positions over the dodecahedra's circumradius,
+    // velocities over the fastest particle's speed, the box's force and the
+    // energies over their sizes.
+    let mut worst = [[0.0f64; 4]; 2];
+    let mut most = (0, 0);
+    for step in 1..=1000 {
+        cpu.step();
+        gpu.step();
+        nudged.step();
+        if step % 100 != 0 {
+            continue;
+        }
+        let (s, t) = (cpu.stats(), gpu.stats());
+        assert_eq!(
+            (s.contacts, s.pair_contacts),
+            (t.contacts, t.pair_contacts),
+            "step {step}"
+        );
+        most = most.max((s.pair_contacts, s.contacts - s.pair_contacts));
+        let a = cpu.world();
+        for (k, other) in [gpu.world(), nudged.world()].into_iter().enumerate() {
+            assert_eq!(a.particles.id, other.particles.id, "step {step}");
+            for (w, d) in worst[k].iter_mut().zip(differences(a, other)) {
+                *w = w.max(d);
+            }
+        }
+        let relative = |x: f64, y: f64| (x - y).abs() / x.abs().max(1e-300);
+        worst[0][3] = worst[0][3]
+            .max(relative(s.elastic_energy, t.elastic_energy))
+            .max(relative(s.dissipated, t.dissipated));
+    }
+    eprintln!(
+        "{} particles, up to {} pair and {} wall contacts; over 1000 steps the device within \
+         {:.1e} of a circumradius in position, {:.1e} of the fastest speed, {:.1e} in the box's \
+         force, {:.1e} in the energies; the CPU nudged by an ulp: {:.1e}, {:.1e}, {:.1e}",
+        cpu.world().particles.len(),
+        most.0,
+        most.1,
+        worst[0][0],
+        worst[0][1],
+        worst[0][2],
+        worst[0][3],
+        worst[1][0],
+        worst[1][1],
+        worst[1][2],
+    );
+    assert!(most.0 > 30 && most.1 > 15, "{most:?}");
+    assert!(worst[0].iter().all(|&e| e < 1e-8), "{worst:?}");
+    for k in 0..3 {
+        assert!(worst[0][k] <= 30.0 * worst[1][k] + 1e-13, "{worst:?}");
+    }
+}
+
+/// The largest difference of `b`'s particles' positions from `a`'s over the
+/// dodecahedra's circumradius, of their velocities over `a`'s fastest speed, and of
+/// the box's force over its size; 0 for the energies (compared apart).
+fn differences(a: &World, b: &World) -> [f64; 4] {
+    let (p, q) = (&a.particles, &b.particles);
+    let position = (p.position.iter().zip(&q.position))
+        .map(|(x, y)| (x - y).norm() / 0.005)
+        .fold(0.0, f64::max);
+    let speed = p.velocity.iter().map(|v| v.norm()).fold(0.0, f64::max);
+    let velocity = (p.velocity.iter().zip(&q.velocity))
+        .map(|(v, w)| (v - w).norm() / speed)
+        .fold(0.0, f64::max);
+    let (f, g) = (&a.walls[0].force, &b.walls[0].force);
+    [position, velocity, (f - g).norm() / f.norm(), 0.0]
 }

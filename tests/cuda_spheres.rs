@@ -17,7 +17,7 @@ use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 use talus::engine::cuda::device::{Device, HostDevice};
 use talus::engine::cuda::driver::CudaDevice;
-use talus::engine::cuda::spheres::{DeviceSpheres, SpheresError};
+use talus::engine::cuda::stepper::{DeviceWorld, StepperError};
 use talus::engine::{Backend, CpuBackend, StepParams};
 use talus::scene::Scene;
 use talus::world::{RunFigures, World};
@@ -168,7 +168,7 @@ fn parity(
     let mut cpu_world = start.clone();
     let mut cpu = CpuBackend::new(*params);
     cpu.initialise(&mut cpu_world, dt);
-    let mut spheres = DeviceSpheres::new(device, start, params).unwrap();
+    let mut spheres = DeviceWorld::new(device, start, params).unwrap();
     spheres.initialise(dt).unwrap();
     let mut device_world = start.clone();
     let (mut most_contacts, mut most_springs, mut most_pairs) = (0, 0, 0);
@@ -392,7 +392,7 @@ fn the_answer_does_not_depend_on_the_block_size() {
     let runs: Vec<(World, (f64, f64))> = [1, 32, 256]
         .into_iter()
         .map(|block| {
-            let mut spheres = DeviceSpheres::new(host(block), &start, &params).unwrap();
+            let mut spheres = DeviceWorld::new(host(block), &start, &params).unwrap();
             spheres.initialise(dt).unwrap();
             for _ in 0..300 {
                 spheres.step(dt).unwrap();
@@ -485,9 +485,9 @@ fn other_laws_are_refused() {
     let (world, params) = cloud();
     let mut volume = params;
     volume.round_law = talus::engine::RoundLaw::Volume;
-    let said = |r: Result<DeviceSpheres, SpheresError>| r.unwrap_err().to_string();
+    let said = |r: Result<DeviceWorld, StepperError>| r.unwrap_err().to_string();
     assert_eq!(
-        said(DeviceSpheres::new(host(64), &world, &volume)),
+        said(DeviceWorld::new(host(64), &world, &volume)),
         "the cuda backend does not yet step a law other than Hertz–Mindlin without rolling resistance"
     );
 }
@@ -517,15 +517,15 @@ geometry = { kind = "box", min = [-0.0039, -0.0039, 0.0], max = [0.0039, 0.0039,
         UnitQuaternion::identity(),
         0,
     );
-    let mut spheres = DeviceSpheres::new(host(64), &world, &params).unwrap();
+    let mut spheres = DeviceWorld::new(host(64), &world, &params).unwrap();
     let e = spheres.initialise(2e-5).unwrap_err();
     assert_eq!(
         e.to_string(),
-        "the device stepper holds no sphere touching walls at more than 4 places at once"
+        "the device stepper holds no particle touching walls at more than 4 places at once"
     );
     // Four places are within the slots.
     world.particles.position[0].x = 0.0005;
-    let mut spheres = DeviceSpheres::new(host(64), &world, &params).unwrap();
+    let mut spheres = DeviceWorld::new(host(64), &world, &params).unwrap();
     spheres.initialise(2e-5).unwrap();
     assert_eq!(spheres.stats().contacts, 4);
 }
@@ -537,7 +537,7 @@ geometry = { kind = "box", min = [-0.0039, -0.0039, 0.0], max = [0.0039, 0.0039,
 fn a_history_set_is_read_back_before_the_next_build() {
     let (start, params) = cloud_in(OPEN_BOX, 30.0);
     let dt = 2e-5;
-    let mut spheres = DeviceSpheres::new(host(64), &start, &params).unwrap();
+    let mut spheres = DeviceWorld::new(host(64), &start, &params).unwrap();
     spheres.initialise(dt).unwrap();
     for _ in 0..300 {
         spheres.step(dt).unwrap();
@@ -546,7 +546,7 @@ fn a_history_set_is_read_back_before_the_next_build() {
     assert!(history.pairs.len() > 20 && !history.walls.is_empty());
     let mut world = start.clone();
     spheres.download(&mut world).unwrap();
-    let mut again = DeviceSpheres::new(host(64), &world, &params).unwrap();
+    let mut again = DeviceWorld::new(host(64), &world, &params).unwrap();
     again.set_history(&history).unwrap();
     assert_eq!(again.contact_history().unwrap(), history);
 }
@@ -561,7 +561,7 @@ fn the_figures_of_the_owned_particles_are_the_hosts() {
     let (whole, params) = cloud_in(OPEN_BOX, 30.0);
     let mut start = as_a_share(&whole, |x| x.x > 0.015);
     let dt = 2e-5;
-    let mut spheres = DeviceSpheres::new(host(64), &start, &params).unwrap();
+    let mut spheres = DeviceWorld::new(host(64), &start, &params).unwrap();
     spheres.initialise(dt).unwrap();
     for _ in 0..200 {
         spheres.step(dt).unwrap();
@@ -597,7 +597,7 @@ fn the_figures_of_the_owned_particles_are_the_hosts() {
 
     let i = start.particles.owned() / 2;
     start.particles.velocity[i].y = f64::NAN;
-    let mut broken = DeviceSpheres::new(host(64), &start, &params).unwrap();
+    let mut broken = DeviceWorld::new(host(64), &start, &params).unwrap();
     let figures = broken.particle_figures().unwrap();
     assert_eq!(figures.non_finite, Some(start.particles.id[i]));
     assert_eq!(figures.non_finite, RunFigures::of(&start).non_finite);

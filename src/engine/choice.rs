@@ -62,7 +62,7 @@ pub fn check(backend: BackendKind, world: &World, params: &StepParams) -> Result
         BackendKind::Cpu => Ok(()),
         #[cfg(feature = "cuda")]
         BackendKind::Cuda => {
-            super::cuda::spheres::DeviceSpheres::check(world, params).map_err(|e| e.to_string())?;
+            super::cuda::stepper::DeviceWorld::check(world, params).map_err(|e| e.to_string())?;
             if super::cuda::driver::CudaDevice::is_present() {
                 Ok(())
             } else {

@@ -192,7 +192,7 @@ pub fn sphere_triangle(
     let normal = if distance > 0.0 {
         offset / distance
     } else {
-        (t[1] - t[0]).cross(&(t[2] - t[0])).normalize()
+        super::wall::facet_normal(t)
     };
     let depth = r - distance;
     Some((

@@ -67,6 +67,12 @@ thread_local! {
     static SCRATCH: RefCell<WallScratch> = RefCell::new(WallScratch::default());
 }
 
+/// The unit normal of the triangle `t`, counter-clockwise seen from the side it
+/// points to: (t₁ − t₀) × (t₂ − t₀), normalised (NaN for a degenerate triangle).
+pub fn facet_normal(t: &[Point3<Real>; 3]) -> Vector3<Real> {
+    (t[1] - t[0]).cross(&(t[2] - t[0])).normalize()
+}
+
 /// Overlap of `poly` with the prism under the triangle `tri` (given in the particle's
 /// body frame, counter-clockwise seen from the particle side). `None` if they do not
 /// overlap.

@@ -10,9 +10,11 @@ use super::patch::{FacetPlane, Merge, PatchSet};
 use super::walls::patch_force;
 use crate::Real;
 use crate::contact::TangentialHistory;
-use crate::engine::cuda::device_wall_patches::{WallContactResult, WallPatch};
+use crate::engine::cuda::device_wall_patches::WallPatch;
+use crate::engine::cuda::device_wall_slots::WallContactResult;
 use crate::engine::laws::ContactLaws;
 use crate::geometry::overlap::OverlapCache;
+use crate::geometry::wall::facet_normal;
 use crate::world::World;
 
 /// A pair's contact as the pair stage finds it: its result and the history it
@@ -79,7 +81,7 @@ pub(in crate::engine) fn wall_patches(world: &World, i: usize) -> Vec<WallPatch>
         patches.clear();
         for f in 0..wall.triangles.len() {
             let tri = wall.facet_world(f);
-            let n = (tri[1] - tri[0]).cross(&(tri[2] - tri[0])).normalize();
+            let n = facet_normal(&tri);
             let height = n.dot(&(p.position[i] - tri[0]));
             if !(0.0..=radius).contains(&height) {
                 continue;

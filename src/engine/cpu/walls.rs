@@ -27,6 +27,7 @@ use crate::engine::backend::WallKey;
 use crate::engine::laws::ContactLaws;
 use crate::engine::neighbours::NeighbourList;
 use crate::geometry::Shape;
+use crate::geometry::wall::facet_normal;
 use crate::world::{Wall, World};
 
 /// Particles near walls per chunk of the wall stage. Only the particles with listed
@@ -96,11 +97,7 @@ impl PlacedFacets {
         self.triangles
             .extend((0..wall.triangles.len()).map(|f| wall.facet_world(f)));
         self.normals.clear();
-        self.normals.extend(
-            self.triangles
-                .iter()
-                .map(|t| (t[1] - t[0]).cross(&(t[2] - t[0])).normalize()),
-        );
+        self.normals.extend(self.triangles.iter().map(facet_normal));
         self.planes.clear();
         (self.planes).extend(
             (self.triangles.iter().zip(&self.normals)).map(|(t, n)| FacetPlane::new(n, &t[0])),

@@ -1,4 +1,4 @@
-//! The CUDA backend behind the seam ([`Backend`]): a [`DeviceSpheres`] on a
+//! The CUDA backend behind the seam ([`Backend`]): a [`DeviceWorld`] on a
 //! [`Device`], kept in step with the host world by the seam's sync contract.
 //!
 //! The device holds the particles between steps; after each step the host world
@@ -21,7 +21,7 @@
 use std::fmt;
 
 use super::device::{Device, DeviceError};
-use super::spheres::{DeviceSpheres, SpheresError};
+use super::stepper::{DeviceWorld, StepperError};
 use crate::Real;
 use crate::engine::backend::{Backend, ContactHistory};
 use crate::engine::params::StepParams;
@@ -34,7 +34,7 @@ pub struct CudaBackend {
     params: StepParams,
     /// The device while no stepper holds it.
     idle: Option<Box<dyn Device>>,
-    spheres: Option<DeviceSpheres>,
+    on_device: Option<DeviceWorld>,
     /// The history to set on the next stepper (a restore, or the one replaced).
     history: Option<ContactHistory>,
     stats: StepStats,
@@ -68,15 +68,15 @@ fn fail(e: impl fmt::Display) -> ! {
 }
 
 impl CudaBackend {
-    /// A backend on `device` stepping `world` (checked: see [`DeviceSpheres::new`]).
+    /// A backend on `device` stepping `world` (checked: see [`DeviceWorld::new`]).
     pub fn new(
         device: Box<dyn Device>,
         world: &World,
         params: StepParams,
-    ) -> Result<Self, SpheresError> {
-        let spheres = DeviceSpheres::new(device, world, &params)?;
+    ) -> Result<Self, StepperError> {
+        let on_device = DeviceWorld::new(device, world, &params)?;
         Ok(CudaBackend {
-            spheres: Some(spheres),
+            on_device: Some(on_device),
             integrated: integrated(world),
             made: 1,
             ..Self::without_device(params)
@@ -85,7 +85,7 @@ impl CudaBackend {
 
     /// A backend on `device` that makes its stepper from the host world at the
     /// first evaluation (a rank's, once it has cut its share; the world checked
-    /// by [`DeviceSpheres::check`] before).
+    /// by [`DeviceWorld::check`] before).
     pub fn idle(device: Box<dyn Device>, params: StepParams) -> Self {
         CudaBackend {
             idle: Some(device),
@@ -98,7 +98,7 @@ impl CudaBackend {
         CudaBackend {
             params,
             idle: None,
-            spheres: None,
+            on_device: None,
             history: None,
             stats: StepStats::default(),
             times: StageTimes::default(),
@@ -117,25 +117,27 @@ impl CudaBackend {
     }
 
     /// The stepper, rebuilt from `world` if the host changed it.
-    fn stepper(&mut self, world: &World) -> &mut DeviceSpheres {
-        if self.spheres.is_none() {
+    fn stepper(&mut self, world: &World) -> &mut DeviceWorld {
+        if self.on_device.is_none() {
             let device = self.idle.take().expect("a device");
-            let mut spheres =
-                DeviceSpheres::new(device, world, &self.params).unwrap_or_else(|e| fail(e));
+            let mut on_device =
+                DeviceWorld::new(device, world, &self.params).unwrap_or_else(|e| fail(e));
             if let Some(history) = self.history.take() {
-                spheres.set_history(&history).unwrap_or_else(|e| fail(e));
+                on_device.set_history(&history).unwrap_or_else(|e| fail(e));
             }
-            self.spheres = Some(spheres);
+            self.on_device = Some(on_device);
             self.integrated = integrated(world);
             self.made += 1;
         }
-        self.spheres.as_mut().expect("a stepper")
+        self.on_device.as_mut().expect("a stepper")
     }
 
     /// Frozen flags and velocities changed on the host: uploaded.
     fn motion_from_host(&mut self, world: &World) {
-        if let Some(spheres) = self.spheres.as_mut() {
-            spheres.motion_from_host(world).unwrap_or_else(|e| fail(e));
+        if let Some(on_device) = self.on_device.as_mut() {
+            on_device
+                .motion_from_host(world)
+                .unwrap_or_else(|e| fail(e));
             self.integrated = integrated(world);
         }
     }
@@ -143,30 +145,30 @@ impl CudaBackend {
     /// Drops the stepper (its history kept): the next evaluation rebuilds it from
     /// the host world.
     fn rebuild(&mut self) {
-        if let Some(spheres) = self.spheres.take() {
+        if let Some(on_device) = self.on_device.take() {
             if self.history.is_none() {
-                self.history = Some(spheres.contact_history().unwrap_or_else(|e| fail(e)));
+                self.history = Some(on_device.contact_history().unwrap_or_else(|e| fail(e)));
             }
-            self.idle = Some(spheres.into_device());
+            self.idle = Some(on_device.into_device());
         }
     }
 
     /// The host world's share of an evaluation: walls, clock, figures (the
     /// touching flags come with the particles, in `sync_to_host`).
     fn report_to_host(&mut self, world: &mut World) {
-        let spheres = self.spheres.as_ref().expect("a stepper");
-        spheres.walls_to_host(world);
+        let on_device = self.on_device.as_ref().expect("a stepper");
+        on_device.walls_to_host(world);
         self.stats = StepStats {
             integrated: self.integrated,
-            ..spheres.stats()
+            ..on_device.stats()
         };
     }
 
     /// The particles and their touching flags into the host world.
     fn particles_to_host(&mut self, world: &mut World) -> Result<(), DeviceError> {
-        if let Some(spheres) = &self.spheres {
-            spheres.particles_to_host(world)?;
-            self.touching = spheres.touching()?;
+        if let Some(on_device) = &self.on_device {
+            on_device.particles_to_host(world)?;
+            self.touching = on_device.touching()?;
         }
         Ok(())
     }
@@ -187,8 +189,8 @@ impl Backend for CudaBackend {
     }
 
     fn initialise(&mut self, world: &mut World, dt: Real) {
-        let spheres = self.stepper(world);
-        spheres.initialise(dt).unwrap_or_else(|e| fail(e));
+        let on_device = self.stepper(world);
+        on_device.initialise(dt).unwrap_or_else(|e| fail(e));
         self.particles_to_host(world).unwrap_or_else(|e| fail(e));
         self.report_to_host(world);
     }
@@ -222,9 +224,9 @@ impl Backend for CudaBackend {
         let appended = added.end == id.len()
             && id[added.clone()].is_sorted()
             && (id[..added.start].iter().max()).is_none_or(|&m| id.get(added.start) > Some(&m));
-        match self.spheres.as_mut() {
-            Some(spheres) if appended && spheres.particles() == added.start => {
-                spheres.append(world).unwrap_or_else(|e| fail(e));
+        match self.on_device.as_mut() {
+            Some(on_device) if appended && on_device.particles() == added.start => {
+                on_device.append(world).unwrap_or_else(|e| fail(e));
                 self.integrated = integrated(world);
             }
             _ => self.rebuild(),
@@ -244,8 +246,8 @@ impl Backend for CudaBackend {
     }
 
     fn walls_moved(&mut self, world: &World) {
-        if let Some(spheres) = self.spheres.as_mut() {
-            spheres.walls_from_host(world).unwrap_or_else(|e| fail(e));
+        if let Some(on_device) = self.on_device.as_mut() {
+            on_device.walls_from_host(world).unwrap_or_else(|e| fail(e));
         }
     }
 
@@ -256,8 +258,8 @@ impl Backend for CudaBackend {
     }
 
     fn contact_history(&self) -> ContactHistory {
-        match &self.spheres {
-            Some(spheres) => spheres.contact_history().unwrap_or_else(|e| fail(e)),
+        match &self.on_device {
+            Some(on_device) => on_device.contact_history().unwrap_or_else(|e| fail(e)),
             None => self.history.clone().unwrap_or_default(),
         }
     }
@@ -278,8 +280,8 @@ impl Backend for CudaBackend {
 
     /// From the device, when it holds a stepper.
     fn particle_figures(&mut self) -> Option<RunFigures> {
-        let spheres = self.spheres.as_mut()?;
-        Some(spheres.particle_figures().unwrap_or_else(|e| fail(e)))
+        let on_device = self.on_device.as_mut()?;
+        Some(on_device.particle_figures().unwrap_or_else(|e| fail(e)))
     }
 }
 
@@ -290,9 +292,9 @@ impl ShareStepper for CudaBackend {
     /// of the step's end into the host world (a renewal makes the stepper again
     /// from it).
     fn drift(&mut self, world: &mut World, dt: Real) {
-        let spheres = self.stepper(world);
-        spheres.drift(dt).unwrap_or_else(|e| fail(e));
-        spheres.walls_to_host(world);
+        let on_device = self.stepper(world);
+        on_device.drift(dt).unwrap_or_else(|e| fail(e));
+        on_device.walls_to_host(world);
     }
 
     /// The sent particles' states, each once, from the device.
@@ -302,22 +304,24 @@ impl ShareStepper for CudaBackend {
         sent.extend(sends.iter().flatten());
         sent.sort_unstable();
         sent.dedup();
-        let spheres = self.stepper(world);
-        spheres
+        let on_device = self.stepper(world);
+        on_device
             .states_to_host(world, &sent)
             .unwrap_or_else(|e| fail(e));
         self.sent = sent;
     }
 
     fn ghosts_from_host(&mut self, world: &World) {
-        let spheres = self.stepper(world);
-        spheres.ghosts_from_host(world).unwrap_or_else(|e| fail(e));
+        let on_device = self.stepper(world);
+        on_device
+            .ghosts_from_host(world)
+            .unwrap_or_else(|e| fail(e));
     }
 
     /// Stale when the device's list is, or when the stepper is to be made again.
     fn is_stale(&mut self, _world: &World) -> bool {
-        match self.spheres.as_mut() {
-            Some(spheres) => spheres.is_stale().unwrap_or_else(|e| fail(e)),
+        match self.on_device.as_mut() {
+            Some(on_device) => on_device.is_stale().unwrap_or_else(|e| fail(e)),
             None => true,
         }
     }

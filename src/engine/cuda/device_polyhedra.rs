@@ -150,6 +150,15 @@ impl DeviceShapes {
         Ok(table)
     }
 
+    /// Bytes of device memory held.
+    pub fn bytes(&self, device: &dyn Device) -> usize {
+        let words = [&self.index, &self.face_span, &self.loops];
+        let doubles = [&self.vertices, &self.planes, &self.circumradius];
+        words.iter().map(|a| a.bytes(device)).sum::<usize>()
+            + doubles.iter().map(|a| a.bytes(device)).sum::<usize>()
+            + self.face_masks.bytes(device)
+    }
+
     /// How many shapes it holds.
     pub fn len(&self) -> usize {
         self.count

@@ -16,6 +16,7 @@ use nalgebra::Vector3;
 use super::Kernel;
 use super::device::{Arg, Array, Device, DeviceError};
 use super::device_polyhedra::{DeviceShapes, ShapeTableError};
+use super::device_states::{DeviceStates, StateView};
 use crate::Real;
 use crate::contact::TangentialHistory;
 use crate::engine::laws::ContactLaws;
@@ -28,9 +29,13 @@ const TYPE_LAW: usize = 7;
 /// Doubles of a pair of materials' law row (`MATERIAL_LAW_DOUBLES`).
 const MATERIAL_LAW: usize = 25;
 /// Doubles of a contact's history (`VOLUME_HISTORY_DOUBLES`).
-const HISTORY: usize = 5;
-/// Doubles of a contact's result (`VOLUME_RESULT_DOUBLES` of polyhedra.cu).
-const RESULT: usize = 12;
+pub(super) const HISTORY: usize = 5;
+/// Doubles of a pair's result and energy terms (`RESULT_DOUBLES` and
+/// `PAIR_ENERGY_DOUBLES` of contact.cuh).
+const RESULT: usize = 9;
+const PAIR_ENERGY: usize = 2;
+/// A pair's byte where it touches (`PAIR_TOUCHES`).
+const PAIR_TOUCHES: u8 = 1;
 
 /// The body types of a world of polyhedra and its pairs of materials on a device.
 ///
@@ -69,6 +74,16 @@ impl DeviceBodyTypes {
             Arg::U32(self.material_count),
             self.material_law.arg(),
         ]
+    }
+
+    /// Bytes of device memory held.
+    pub fn bytes(&self, device: &dyn Device) -> usize {
+        let doubles = [&self.mass, &self.inertia, &self.law, &self.material_law];
+        self.shapes.bytes(device)
+            + doubles.iter().map(|a| a.bytes(device)).sum::<usize>()
+            + self.shape.bytes(device)
+            + self.material.bytes(device)
+            + self.isotropic.bytes(device)
     }
 
     /// Uploads the body types and materials of `world`, the laws' rows made for
@@ -147,56 +162,6 @@ impl DeviceBodyTypes {
     }
 }
 
-/// The particles' states on a device, as the contact kernels read them: position,
-/// orientation (i, j, k, w, as nalgebra stores it), velocity, angular momentum and
-/// body type.
-#[derive(Debug, Default)]
-pub struct DeviceStates {
-    pub(super) position: Array<Real>,
-    pub(super) orientation: Array<Real>,
-    velocity: Array<Real>,
-    angular_momentum: Array<Real>,
-    pub(super) body_type: Array<u32>,
-}
-
-impl DeviceStates {
-    /// The states as launch arguments: position, orientation, velocity, angular
-    /// momentum, body type.
-    pub(super) fn args(&self) -> [Arg; 5] {
-        [
-            self.position.arg(),
-            self.orientation.arg(),
-            self.velocity.arg(),
-            self.angular_momentum.arg(),
-            self.body_type.arg(),
-        ]
-    }
-
-    /// Copies the states of `world`'s particles in.
-    pub fn upload(&mut self, device: &mut dyn Device, world: &World) -> Result<(), DeviceError> {
-        let p = &world.particles;
-        let flat = |v: &[Vector3<Real>]| -> Vec<Real> {
-            v.iter().flat_map(|x| x.iter().copied()).collect()
-        };
-        let position: Vec<Real> = p
-            .position
-            .iter()
-            .flat_map(|x| x.coords.iter().copied())
-            .collect();
-        let orientation: Vec<Real> = p
-            .orientation
-            .iter()
-            .flat_map(|q| q.as_ref().coords.iter().copied())
-            .collect();
-        self.position.write(device, &position)?;
-        self.orientation.write(device, &orientation)?;
-        self.velocity.write(device, &flat(&p.velocity))?;
-        self.angular_momentum
-            .write(device, &flat(&p.angular_momentum))?;
-        self.body_type.write(device, &p.body_type)
-    }
-}
-
 /// One contact's result: what the CPU backend's pair stage gathers.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct VolumeContactResult {
@@ -212,6 +177,54 @@ pub struct VolumeContactResult {
     pub touching: bool,
 }
 
+/// The arrays a pass of [`polyhedron_contacts`] writes, per candidate pair: its
+/// history (read and replaced), its result (force on the second particle, torque
+/// on the first and on the second: 9 doubles), its energy terms (elastic energy and
+/// dissipation, 2 doubles, zero where the world does not count the pair) and its
+/// byte (touches, counted: `kernels/contact.cuh`), as `kernels/spheres.cu` writes
+/// them for spheres.
+pub(super) struct PairOutputs<'a> {
+    pub history: &'a Array<Real>,
+    pub results: &'a Array<Real>,
+    pub energies: &'a Array<Real>,
+    pub touching: &'a Array<u8>,
+}
+
+/// Launches the volume law's contacts of the `count` candidate pairs `pairs` (two
+/// particle indices each) over a step of `dt` (see the module).
+///
+/// # Safety
+/// `states` holds every particle a pair names, `types` every body type of those
+/// particles, and `out` room for `count` pairs.
+pub(super) unsafe fn polyhedron_contacts(
+    device: &mut dyn Device,
+    types: &DeviceBodyTypes,
+    states: &StateView,
+    count: usize,
+    pairs: &Array<u32>,
+    out: &PairOutputs,
+    dt: Real,
+) -> Result<(), DeviceError> {
+    if count == 0 {
+        return Ok(());
+    }
+    let mut args = vec![Arg::U32(count as u32), Arg::F64(dt), pairs.arg()];
+    args.extend(states.args());
+    args.push(states.role.arg());
+    args.extend(types.law_args());
+    args.push(types.shape.arg());
+    args.extend(types.shapes.args());
+    args.extend([
+        out.history.arg(),
+        out.results.arg(),
+        out.energies.arg(),
+        out.touching.arg(),
+    ]);
+    // SAFETY: the parameters of polyhedron_contacts (polyhedra.cu), each array
+    // sized as the caller promises.
+    unsafe { device.launch(Kernel::PolyhedronContacts, count, &args) }
+}
+
 /// Candidate pairs of polyhedra on a device, with each pair's friction history and
 /// the results of its last evaluation.
 #[derive(Debug, Default)]
@@ -220,6 +233,8 @@ pub struct VolumeContacts {
     pairs: Array<u32>,
     history: Array<Real>,
     results: Array<Real>,
+    energies: Array<Real>,
+    touching: Array<u8>,
     host: Vec<Real>,
 }
 
@@ -243,7 +258,9 @@ impl VolumeContacts {
             self.host.extend([h.stiffness, h.twist]);
         }
         self.history.write(device, &self.host)?;
-        self.results.resize(device, RESULT * pairs.len())
+        self.results.resize(device, RESULT * pairs.len())?;
+        self.energies.resize(device, PAIR_ENERGY * pairs.len())?;
+        self.touching.resize(device, pairs.len())
     }
 
     /// Evaluates every pair's contact over a step of `dt` (see the module).
@@ -257,19 +274,16 @@ impl VolumeContacts {
         states: &DeviceStates,
         dt: Real,
     ) -> Result<(), DeviceError> {
+        let out = PairOutputs {
+            history: &self.history,
+            results: &self.results,
+            energies: &self.energies,
+            touching: &self.touching,
+        };
         let count = self.pairs.len() / 2;
-        if count == 0 {
-            return Ok(());
-        }
-        let mut args = vec![Arg::U32(count as u32), Arg::F64(dt), self.pairs.arg()];
-        args.extend(states.args());
-        args.extend(types.law_args());
-        args.push(types.shape.arg());
-        args.extend(types.shapes.args());
-        args.extend([self.history.arg(), self.results.arg()]);
-        // SAFETY: the arrays' invariants and the caller's: two particles per pair,
-        // a history and a result per pair.
-        unsafe { device.launch(Kernel::PolyhedronContacts, count, &args) }
+        // SAFETY: the caller's promise on the states and types; a history, result,
+        // energy and byte per pair (set_pairs).
+        unsafe { polyhedron_contacts(device, types, &states.view(), count, &self.pairs, &out, dt) }
     }
 
     /// The results of the last evaluation.
@@ -277,17 +291,16 @@ impl VolumeContacts {
         &mut self,
         device: &dyn Device,
     ) -> Result<Vec<VolumeContactResult>, DeviceError> {
+        let (energies, touching) = (self.energies.read(device)?, self.touching.read(device)?);
         self.results.read_into(device, &mut self.host)?;
         let v = |r: &[Real], k: usize| Vector3::new(r[k], r[k + 1], r[k + 2]);
-        Ok(self
-            .host
-            .chunks_exact(RESULT)
-            .map(|r| VolumeContactResult {
+        Ok((self.host.chunks_exact(RESULT).enumerate())
+            .map(|(e, r)| VolumeContactResult {
                 force: v(r, 0),
                 torques: [v(r, 3), v(r, 6)],
-                energy: r[9],
-                dissipated: r[10],
-                touching: r[11] != 0.0,
+                energy: energies[PAIR_ENERGY * e],
+                dissipated: energies[PAIR_ENERGY * e + 1],
+                touching: touching[e] & PAIR_TOUCHES != 0,
             })
             .collect())
     }

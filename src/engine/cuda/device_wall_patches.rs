@@ -11,14 +11,15 @@ use nalgebra::{Point3, Vector3};
 
 use super::Kernel;
 use super::device::{Arg, Array, Device, DeviceError};
-use super::device_volume_contacts::{DeviceBodyTypes, DeviceStates};
+use super::device_states::StateView;
+use super::device_volume_contacts::DeviceBodyTypes;
+use super::device_wall_placement::PlacedWalls;
+use super::device_wall_slots::WallSlots;
 use crate::Real;
-use crate::contact::TangentialHistory;
-use crate::world::World;
 
 /// Patches a particle may have against all walls at once (`WALL_SLOTS` of
-/// triangle.cuh: the slots of the spheres' wall contacts).
-pub const PATCH_SLOTS: usize = super::device_walls::SLOTS;
+/// triangle.cuh: the slots of its wall contacts).
+pub const PATCH_SLOTS: usize = super::device_wall_slots::SLOTS;
 /// Facets one patch may sum (`SHARE_SLOTS`).
 pub const SHARE_SLOTS: usize = 16;
 /// Doubles of a patch's geometry (`PATCH_DOUBLES`).
@@ -45,19 +46,9 @@ pub struct WallPatch {
     pub shares: Vec<(u32, Real)>,
 }
 
-/// The walls' facets as placed in the world, and the patches last found.
+/// The patches of each particle against the walls, as last found.
 #[derive(Debug, Default)]
 pub struct DeviceWallPatches {
-    walls: u32,
-    /// Per wall its first facet, and after the last wall the facet count.
-    wall_facets: Array<u32>,
-    /// Per facet its triangle (9 doubles) and unit normal (3).
-    facets: Array<Real>,
-    normals: Array<Real>,
-    /// Per wall its material, and its velocity, angular velocity and reference
-    /// point (9 doubles).
-    wall_material: Array<u32>,
-    wall_motion: Array<Real>,
     count: Array<u32>,
     wall: Array<u32>,
     keys: Array<i64>,
@@ -69,43 +60,44 @@ pub struct DeviceWallPatches {
 }
 
 impl DeviceWallPatches {
-    /// Uploads the facets of `world`'s walls as placed at their poses now, with the
-    /// normals the CPU's wall stage computes, and the walls' materials and motions.
-    pub fn place_walls(
-        &mut self,
-        device: &mut dyn Device,
-        world: &World,
-    ) -> Result<(), DeviceError> {
-        let (mut starts, mut facets, mut normals) = (vec![0u32], Vec::new(), Vec::new());
-        let (mut material, mut motion) = (Vec::new(), Vec::new());
-        for wall in &world.walls {
-            material.push(wall.material as u32);
-            motion.extend(wall.velocity.iter().chain(&wall.angular_velocity));
-            motion.extend(wall.reference().coords.iter());
-            for f in 0..wall.triangles.len() {
-                let t = wall.facet_world(f);
-                let n = (t[1] - t[0]).cross(&(t[2] - t[0])).normalize();
-                facets.extend(t.iter().flat_map(|p| p.coords.iter().copied()));
-                normals.extend(n.iter());
-            }
-            starts.push((facets.len() / 9) as u32);
-        }
-        self.walls = world.walls.len() as u32;
-        self.wall_facets.write(device, &starts)?;
-        self.facets.write(device, &facets)?;
-        self.normals.write(device, &normals)?;
-        self.wall_material.write(device, &material)?;
-        self.wall_motion.write(device, &motion)
-    }
-
-    /// Finds every particle's patches against the walls placed (see the module).
-    pub fn find(
+    /// Finds every particle's patches against the walls placed (see the module),
+    /// an error where they do not fit (the tests' call; a stepper launches the
+    /// search with its own flag, read with its other figures).
+    #[cfg(test)]
+    pub(super) fn find(
         &mut self,
         device: &mut dyn Device,
         types: &DeviceBodyTypes,
-        states: &DeviceStates,
+        states: &StateView,
+        walls: &PlacedWalls,
     ) -> Result<(), DeviceError> {
-        let n = states.body_type.len();
+        self.overflow.write(device, &[0])?;
+        let overflow = self.overflow.arg();
+        // SAFETY: `overflow` holds a word.
+        unsafe { self.launch_find(device, types, states, walls, overflow)? };
+        if self.overflow.get(device, 0)? != 0 {
+            return Err(DeviceError::Capacity(format!(
+                "polyhedron touching walls in more than {PATCH_SLOTS} planes at once, or over \
+                 more than {SHARE_SLOTS} facets of one plane"
+            )));
+        }
+        Ok(())
+    }
+
+    /// Launches the search of [`Self::find`], the word `overflow` set where a
+    /// particle's patches do not fit.
+    ///
+    /// # Safety
+    /// `overflow` is a device word.
+    pub(super) unsafe fn launch_find(
+        &mut self,
+        device: &mut dyn Device,
+        types: &DeviceBodyTypes,
+        states: &StateView,
+        walls: &PlacedWalls,
+        overflow: Arg,
+    ) -> Result<(), DeviceError> {
+        let n = states.len();
         let slots = PATCH_SLOTS * n;
         self.count.resize(device, n)?;
         self.wall.resize(device, slots)?;
@@ -114,7 +106,6 @@ impl DeviceWallPatches {
         self.shares.resize(device, slots)?;
         self.share_facet.resize(device, SHARE_SLOTS * slots)?;
         self.share_volume.resize(device, SHARE_SLOTS * slots)?;
-        self.overflow.write(device, &[0])?;
         if n == 0 {
             return Ok(());
         }
@@ -123,14 +114,15 @@ impl DeviceWallPatches {
             states.position.arg(),
             states.orientation.arg(),
             states.body_type.arg(),
+            states.role.arg(),
             types.shape.arg(),
         ];
         args.extend(types.shapes.args());
         args.extend([
-            Arg::U32(self.walls),
-            self.wall_facets.arg(),
-            self.facets.arg(),
-            self.normals.arg(),
+            walls.count_arg(),
+            walls.wall_facets.arg(),
+            walls.facets.arg(),
+            walls.normals.arg(),
             self.count.arg(),
             self.wall.arg(),
             self.keys.arg(),
@@ -138,18 +130,21 @@ impl DeviceWallPatches {
             self.shares.arg(),
             self.share_facet.arg(),
             self.share_volume.arg(),
-            self.overflow.arg(),
+            overflow,
         ]);
         // SAFETY: the arrays sized above for `n` particles, the states' and the
-        // body types' invariants, the walls placed.
-        unsafe { device.launch(Kernel::PolyhedronWallPatches, n, &args)? };
-        if self.overflow.get(device, 0)? != 0 {
-            return Err(DeviceError::Capacity(format!(
-                "polyhedron touching walls in more than {PATCH_SLOTS} planes at once, or over \
-                 more than {SHARE_SLOTS} facets of one plane"
-            )));
-        }
-        Ok(())
+        // body types' invariants, the walls placed, the caller's overflow word.
+        unsafe { device.launch(Kernel::PolyhedronWallPatches, n, &args) }
+    }
+
+    /// Bytes of device memory held.
+    pub fn bytes(&self, device: &dyn Device) -> usize {
+        let words = [&self.count, &self.wall, &self.shares, &self.share_facet];
+        words.iter().map(|a| a.bytes(device)).sum::<usize>()
+            + self.keys.bytes(device)
+            + self.geometry.bytes(device)
+            + self.share_volume.bytes(device)
+            + self.overflow.bytes(device)
     }
 
     /// Each particle's patches as last found, in wall order.
@@ -197,150 +192,85 @@ impl DeviceWallPatches {
     }
 }
 
-/// Doubles of a wall contact's result (`WALL_RESULT_DOUBLES` of polyhedra.cu).
-const WALL_RESULT: usize = 8;
-/// Doubles of a contact's history (`VOLUME_HISTORY_DOUBLES`).
-const HISTORY: usize = 5;
-
-/// One wall contact of a polyhedron: what its patch puts on the particle.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct WallContactResult {
-    /// The wall's index and the plane's key.
-    pub wall: u32,
-    pub key: [i64; 4],
-    /// Force on the particle; the wall gets the opposite.
-    pub force: Vector3<Real>,
-    /// Torque on the particle about its centroid.
-    pub torque: Vector3<Real>,
-    pub energy: Real,
-    pub dissipated: Real,
-    /// The friction spring and twist it keeps.
-    pub history: TangentialHistory,
+/// What the wall contacts add to: each particle's force and torque (the pairs'
+/// gathered) and whether it touches.
+pub(super) struct Loads<'a> {
+    pub force: &'a Array<Real>,
+    pub torque: &'a Array<Real>,
+    pub touching: &'a Array<u8>,
 }
 
-/// The volume law's contacts of the polyhedra's wall patches on a device, with
-/// each particle's friction springs of the step before (by wall and plane key) and
-/// of this step, in [`PATCH_SLOTS`] slots a particle.
-#[derive(Debug, Default)]
-pub struct PolyhedronWallContacts {
-    old_count: Array<u32>,
-    old_keys: Array<i64>,
-    old_history: Array<Real>,
-    count: Array<u32>,
-    keys: Array<i64>,
-    history: Array<Real>,
-    results: Array<Real>,
+/// Evaluates the contact of every patch `patches` last found (for the same
+/// states and walls) over a step of `dt`, each with the spring its wall and plane
+/// key held in the step before's slots, into this step's `slots`, and adds it to
+/// the particle's load (`polyhedron_wall_contacts` of polyhedra.cu).
+#[allow(clippy::too_many_arguments)]
+pub(super) fn polyhedron_wall_contacts(
+    device: &mut dyn Device,
+    types: &DeviceBodyTypes,
+    states: &StateView,
+    walls: &PlacedWalls,
+    patches: &DeviceWallPatches,
+    slots: &WallSlots,
+    loads: &Loads,
+    dt: Real,
+) -> Result<(), DeviceError> {
+    let n = states.len();
+    if n == 0 {
+        return Ok(());
+    }
+    let mut args = vec![Arg::U32(n as u32), Arg::F64(dt)];
+    args.extend(states.args());
+    args.extend(types.law_args());
+    args.extend([
+        walls.material.arg(),
+        walls.motion.arg(),
+        patches.count.arg(),
+        patches.wall.arg(),
+        patches.keys.arg(),
+        patches.geometry.arg(),
+        patches.shares.arg(),
+        patches.share_volume.arg(),
+    ]);
+    args.extend(slots.args());
+    args.extend([loads.force.arg(), loads.torque.arg(), loads.touching.arg()]);
+    // SAFETY: every array sized for `n` particles and their slots: the patches
+    // found for the same states and walls, the slots made for as many particles.
+    unsafe { device.launch(Kernel::PolyhedronWallContacts, n, &args) }
 }
 
-impl PolyhedronWallContacts {
-    /// Sets each particle's springs of the step before: `(wall, key, history)`,
-    /// at most [`PATCH_SLOTS`] a particle.
-    ///
-    /// # Panics
-    /// When a particle holds more than [`PATCH_SLOTS`] springs.
-    pub fn set_history(
-        &mut self,
-        device: &mut dyn Device,
-        held: &[Vec<(u32, [i64; 4], TangentialHistory)>],
-    ) -> Result<(), DeviceError> {
-        let slots = PATCH_SLOTS * held.len();
-        let (mut count, mut keys, mut history) =
-            (Vec::new(), vec![0; 5 * slots], vec![0.0; HISTORY * slots]);
-        for (i, springs) in held.iter().enumerate() {
-            assert!(springs.len() <= PATCH_SLOTS, "a spring a slot");
-            count.push(springs.len() as u32);
-            for (s, (wall, key, h)) in springs.iter().enumerate() {
-                let slot = PATCH_SLOTS * i + s;
-                keys[5 * slot] = i64::from(*wall);
-                keys[5 * slot + 1..5 * slot + 5].copy_from_slice(key);
-                let at = HISTORY * slot;
-                history[at..at + 3].copy_from_slice(h.spring.as_slice());
-                history[at + 3] = h.stiffness;
-                history[at + 4] = h.twist;
-            }
-        }
-        self.old_count.write(device, &count)?;
-        self.old_keys.write(device, &keys)?;
-        self.old_history.write(device, &history)
-    }
-
-    /// Evaluates the contact of every patch `patches` last found, over a step of
-    /// `dt` (the springs set by [`Self::set_history`] for the same particles).
-    pub fn evaluate(
-        &mut self,
-        device: &mut dyn Device,
-        types: &DeviceBodyTypes,
-        states: &DeviceStates,
-        patches: &DeviceWallPatches,
-        dt: Real,
-    ) -> Result<(), DeviceError> {
-        let n = states.body_type.len();
-        let slots = PATCH_SLOTS * n;
-        self.count.resize(device, n)?;
-        self.keys.resize(device, 5 * slots)?;
-        self.history.resize(device, HISTORY * slots)?;
-        self.results.resize(device, WALL_RESULT * slots)?;
-        if n == 0 {
-            return Ok(());
-        }
-        let mut args = vec![Arg::U32(n as u32), Arg::F64(dt)];
-        args.extend(states.args());
-        args.extend(types.law_args());
-        args.extend([
-            patches.wall_material.arg(),
-            patches.wall_motion.arg(),
-            patches.count.arg(),
-            patches.wall.arg(),
-            patches.keys.arg(),
-            patches.geometry.arg(),
-            self.old_count.arg(),
-            self.old_keys.arg(),
-            self.old_history.arg(),
-            self.count.arg(),
-            self.keys.arg(),
-            self.history.arg(),
-            self.results.arg(),
-        ]);
-        // SAFETY: every array sized for `n` particles and their slots: the
-        // patches found for the same states, the springs set for them.
-        unsafe { device.launch(Kernel::PolyhedronWallContacts, n, &args) }
-    }
-
-    /// Each particle's wall contacts as last evaluated.
-    pub fn results(&self, device: &dyn Device) -> Result<Vec<Vec<WallContactResult>>, DeviceError> {
-        let (count, keys) = (self.count.read(device)?, self.keys.read(device)?);
-        let (history, results) = (self.history.read(device)?, self.results.read(device)?);
-        let v = |r: &[Real], k: usize| Vector3::new(r[k], r[k + 1], r[k + 2]);
-        let contact = |slot: usize| {
-            let (r, h) = (
-                &results[WALL_RESULT * slot..WALL_RESULT * (slot + 1)],
-                &history[HISTORY * slot..HISTORY * (slot + 1)],
-            );
-            WallContactResult {
-                wall: keys[5 * slot] as u32,
-                key: keys[5 * slot + 1..5 * slot + 5]
-                    .try_into()
-                    .expect("four words"),
-                force: v(r, 0),
-                torque: v(r, 3),
-                energy: r[6],
-                dissipated: r[7],
-                history: TangentialHistory {
-                    spring: v(h, 0),
-                    stiffness: h[3],
-                    twist: h[4],
-                    ..Default::default()
-                },
-            }
-        };
-        Ok(count
-            .iter()
-            .enumerate()
-            .map(|(i, &c)| {
-                (0..c as usize)
-                    .map(|s| contact(PATCH_SLOTS * i + s))
-                    .collect()
-            })
-            .collect())
-    }
+/// Launches the first pass of the walls' sums of polyhedra over `n` particles'
+/// contacts into `rows` rows (`polyhedron_wall_sum_rows` of polyhedra.cu).
+///
+/// # Safety
+/// `partials` has room for `rows` rows of the walls' width (6 per wall, 3 per
+/// facet); the slots and patches hold the same `n` particles'.
+pub(super) unsafe fn polyhedron_wall_sum_rows(
+    device: &mut dyn Device,
+    position: &Array<Real>,
+    walls: &PlacedWalls,
+    patches: &DeviceWallPatches,
+    slots: &WallSlots,
+    rows: usize,
+    partials: &Array<Real>,
+) -> Result<(), DeviceError> {
+    let n = position.len() / 3;
+    let args = [
+        Arg::U32(n as u32),
+        position.arg(),
+        walls.count_arg(),
+        walls.wall_facets.arg(),
+        walls.motion.arg(),
+        slots.new.count.arg(),
+        slots.new.keys.arg(),
+        slots.records.arg(),
+        slots.record_index.arg(),
+        patches.shares.arg(),
+        patches.share_facet.arg(),
+        patches.share_volume.arg(),
+        Arg::U32(rows as u32),
+        partials.arg(),
+    ];
+    // SAFETY: the caller's promise.
+    unsafe { device.launch(Kernel::PolyhedronWallSumRows, rows, &args) }
 }

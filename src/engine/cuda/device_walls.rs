@@ -1,47 +1,36 @@
-//! The walls of a world of spheres on a device (`kernels/walls.cu`): their facets
-//! as placed in the world, their motion, each particle's contacts with them and
-//! their friction springs, and the walls' forces.
+//! The walls of a world on a device: their facets as placed in the world
+//! ([`PlacedWalls`]), each particle's contacts with them and their tangential
+//! history ([`WallSlots`]), and the walls' forces. A sphere's contacts are
+//! Hertz–Mindlin's (`kernels/walls.cu`), a polyhedron's the volume law's of its
+//! patches (`kernels/polyhedra.cu`, `device_wall_patches.rs`).
 //!
 //! The walls move on the host, by the CPU backend's own stage (their motions are
 //! prescribed or set from outside, a few numbers a step): a copy of the world
 //! without particles is advanced each step, and a wall whose pose changed has its
 //! facets placed again and uploaded with its velocities.
 
-use nalgebra::{Isometry3, Point3, Vector3};
+use nalgebra::Vector3;
 
 use super::Kernel;
 use super::device::{Arg, Array, Device, DeviceError};
 use super::device_list::run;
+use super::device_states::StateView;
 use super::device_sums::{RowSums, first_rows};
+use super::device_volume_contacts::{DeviceBodyTypes, HISTORY as VOLUME_HISTORY};
+use super::device_wall_patches::{
+    DeviceWallPatches, Loads, polyhedron_wall_contacts, polyhedron_wall_sum_rows,
+};
+use super::device_wall_placement::PlacedWalls;
+use super::device_wall_slots::WallSlots;
 use super::readback::{self, Readback};
 use crate::Real;
+use crate::contact::TangentialHistory;
 use crate::engine::backend::WallKey;
 use crate::engine::cpu::motion::advance_walls;
 use crate::world::World;
 
-/// Contacts a particle may have with the walls at once (`WALL_SLOTS` of triangle.cuh).
-pub(super) const SLOTS: usize = 4;
-/// Words of a contact's key: the wall and the plane's four rounded numbers.
-const KEY: usize = 5;
-/// Doubles of a contact's friction spring.
+/// Doubles of a Hertz–Mindlin contact's friction spring.
 const SPRING: usize = 4;
-/// Doubles of a contact's record for the sums.
-const RECORD: usize = 9;
-
-/// One set of per-particle contact slots: counts, keys, springs.
-#[derive(Debug, Default)]
-struct Slots {
-    count: Array<u32>,
-    keys: Array<i64>,
-    springs: Array<Real>,
-}
-
-/// The error of a sphere touching walls at more places than it has slots for.
-pub(super) fn too_many_wall_contacts() -> DeviceError {
-    DeviceError::Capacity(format!(
-        "sphere touching walls at more than {SLOTS} places at once"
-    ))
-}
 
 /// Doubles the rows of the walls' first pass may take together (32 MiB): a row for
 /// every 8 particles where that fits, fewer for walls of many facets (each row
@@ -53,93 +42,68 @@ fn wall_sum_rows(n: usize, width: usize) -> usize {
     (WALL_ROWS_DOUBLES / width.max(1)).clamp(1, first_rows(n))
 }
 
+/// What the particles' contacts with the walls follow.
+#[derive(Debug)]
+pub(super) enum WallLaw<'a> {
+    /// Hertz–Mindlin spheres: per body type its radius, mass, principal moments
+    /// and material, and per pair of materials its row (`kernels/walls.cu`).
+    Hertz {
+        type_radius: &'a Array<Real>,
+        type_mass: &'a Array<Real>,
+        type_inertia: &'a Array<Real>,
+        type_material: &'a Array<u32>,
+        materials: u32,
+        material_pairs: &'a Array<Real>,
+    },
+    /// Polyhedra under the volume law.
+    Volume(&'a DeviceBodyTypes),
+}
+
+/// What the wall contacts read and add to.
+pub(super) struct WallInputs<'a> {
+    pub dt: Real,
+    pub states: StateView<'a>,
+    pub law: WallLaw<'a>,
+    pub loads: Loads<'a>,
+}
+
 /// The walls on a device and their host copy (see the module).
 #[derive(Debug)]
 pub(super) struct DeviceWalls {
     /// The world's walls, materials and clock, without particles: what moves them.
     host: World,
-    /// The pose each wall's facets were placed at.
-    placed: Vec<Option<Isometry3<Real>>>,
-    wall_facets: Array<u32>,
-    facets: Array<Real>,
-    normals: Array<Real>,
-    material: Array<u32>,
-    /// Per wall: velocity, angular velocity, reference point.
-    motion: Array<Real>,
-    old: Slots,
-    new: Slots,
-    records: Array<Real>,
-    record_facet: Array<u32>,
+    placed: PlacedWalls,
+    slots: WallSlots,
+    /// The patches of polyhedra (none for spheres).
+    patches: Option<DeviceWallPatches>,
     /// Scratch of the walls' sums (folded into the readback: per wall its force
     /// and torque, then per facet its force).
     sums: RowSums,
 }
 
-/// What the wall kernel reads of the particles and their types.
-pub(super) struct WallInputs<'a> {
-    pub n: usize,
-    pub dt: Real,
-    pub position: &'a Array<Real>,
-    pub velocity: &'a Array<Real>,
-    pub orientation: &'a Array<Real>,
-    pub angular_momentum: &'a Array<Real>,
-    pub body_type: &'a Array<u32>,
-    pub role: &'a Array<u8>,
-    pub type_radius: &'a Array<Real>,
-    pub type_mass: &'a Array<Real>,
-    pub type_inertia: &'a Array<Real>,
-    pub type_material: &'a Array<u32>,
-    pub materials: u32,
-    pub material_pairs: &'a Array<Real>,
-    pub force: &'a Array<Real>,
-    pub torque: &'a Array<Real>,
-    pub touching: &'a Array<u8>,
-}
-
 impl DeviceWalls {
-    /// The walls of `world`, placed and uploaded, for `n` particles.
-    pub fn new(device: &mut dyn Device, world: &World, n: usize) -> Result<Self, DeviceError> {
+    /// The walls of `world`, placed and uploaded, for `n` particles: spheres, or
+    /// where `polyhedra`, polyhedra under the volume law.
+    pub fn new(
+        device: &mut dyn Device,
+        world: &World,
+        n: usize,
+        polyhedra: bool,
+    ) -> Result<Self, DeviceError> {
         let mut host = world.clone();
         host.particles = Default::default();
         host.fluid = None;
-        let mut starts = vec![0u32];
-        for wall in &host.walls {
-            starts.push(starts[starts.len() - 1] + wall.triangles.len() as u32);
-        }
-        let facets = *starts.last().expect("a start") as usize;
-        let mut walls = DeviceWalls {
-            placed: vec![None; host.walls.len()],
-            wall_facets: Array::default(),
-            facets: Array::default(),
-            normals: Array::default(),
-            material: Array::default(),
-            motion: Array::default(),
-            old: Slots::default(),
-            new: Slots::default(),
-            records: Array::default(),
-            record_facet: Array::default(),
-            sums: RowSums::default(),
-            host,
-        };
-        walls.wall_facets.write(device, &starts)?;
         // Without walls the per-particle slots hold nothing (the energy sum still
         // takes them as arguments).
-        let n = if walls.host.walls.is_empty() { 0 } else { n };
-        let materials: Vec<u32> = walls.host.walls.iter().map(|w| w.material as u32).collect();
-        walls.material.write(device, &materials)?;
-        walls.facets.resize(device, 9 * facets)?;
-        walls.normals.resize(device, 3 * facets)?;
-        let count = walls.host.walls.len();
-        walls.motion.resize(device, 9 * count)?;
-        for slots in [&mut walls.old, &mut walls.new] {
-            slots.count.resize(device, n)?;
-            slots.keys.resize(device, KEY * SLOTS * n)?;
-            slots.springs.resize(device, SPRING * SLOTS * n)?;
-        }
-        walls.records.resize(device, RECORD * SLOTS * n)?;
-        walls.record_facet.resize(device, SLOTS * n)?;
-        walls.upload_placement(device)?;
-        Ok(walls)
+        let n = if host.walls.is_empty() { 0 } else { n };
+        let width = if polyhedra { VOLUME_HISTORY } else { SPRING };
+        Ok(DeviceWalls {
+            placed: PlacedWalls::new(device, &host.walls)?,
+            slots: WallSlots::new(device, n, width)?,
+            patches: polyhedra.then(DeviceWallPatches::default),
+            sums: RowSums::default(),
+            host,
+        })
     }
 
     /// Makes room for `n` particles, the first of them already here keeping their
@@ -148,40 +112,19 @@ impl DeviceWalls {
         if self.is_empty() {
             return Ok(());
         }
-        // The last evaluation's slots are the next one's history; the others are
-        // written whole by every evaluation.
-        self.new.count.grow_zeroed(device, n)?;
-        self.new.keys.grow_zeroed(device, KEY * SLOTS * n)?;
-        self.new.springs.grow_zeroed(device, SPRING * SLOTS * n)?;
-        self.old.count.resize(device, n)?;
-        self.old.keys.resize(device, KEY * SLOTS * n)?;
-        self.old.springs.resize(device, SPRING * SLOTS * n)?;
-        self.records.resize(device, RECORD * SLOTS * n)?;
-        self.record_facet.resize(device, SLOTS * n)
+        self.slots.grow(device, n)
     }
 
     /// Bytes of device memory the walls hold: their facets and, per particle,
-    /// [`SLOTS`] contacts (two sets of keys and springs, and the records).
+    /// [`super::device_wall_slots::SLOTS`] contacts (and polyhedra's patches).
     pub fn bytes(&self, device: &dyn Device) -> usize {
-        let doubles = [
-            &self.facets,
-            &self.normals,
-            &self.motion,
-            &self.old.springs,
-            &self.new.springs,
-            &self.records,
-        ];
-        let words = [
-            &self.wall_facets,
-            &self.material,
-            &self.old.count,
-            &self.new.count,
-            &self.record_facet,
-        ];
+        let p = &self.placed;
+        let doubles = [&p.facets, &p.normals, &p.motion];
+        let words = [&p.wall_facets, &p.material];
         doubles.iter().map(|a| a.bytes(device)).sum::<usize>()
             + words.iter().map(|a| a.bytes(device)).sum::<usize>()
-            + self.old.keys.bytes(device)
-            + self.new.keys.bytes(device)
+            + self.slots.bytes(device)
+            + self.patches.as_ref().map_or(0, |p| p.bytes(device))
             + self.sums.bytes(device)
     }
 
@@ -198,132 +141,138 @@ impl DeviceWalls {
     /// Moves the walls over `dt` (the CPU backend's stage) and uploads what moved.
     pub fn advance(&mut self, device: &mut dyn Device, dt: Real) -> Result<(), DeviceError> {
         advance_walls(&mut self.host, dt);
-        self.upload_placement(device)
-    }
-
-    /// Places the facets of every wall whose pose changed (as the CPU backend's wall
-    /// stage places them: corners by the pose, unit normals of the placed corners)
-    /// and uploads them, and every wall's velocities and reference point.
-    fn upload_placement(&mut self, device: &mut dyn Device) -> Result<(), DeviceError> {
-        let mut motion = Vec::with_capacity(9 * self.host.walls.len());
-        let mut first = 0;
-        for (w, wall) in self.host.walls.iter().enumerate() {
-            let reference = wall.reference();
-            motion.extend(
-                wall.velocity
-                    .iter()
-                    .chain(wall.angular_velocity.iter())
-                    .copied(),
-            );
-            motion.extend(reference.coords.iter().copied());
-            let facets = wall.triangles.len();
-            if self.placed[w] != Some(wall.pose) {
-                self.placed[w] = Some(wall.pose);
-                let triangles: Vec<[Point3<Real>; 3]> =
-                    (0..facets).map(|f| wall.facet_world(f)).collect();
-                let corners: Vec<Real> = triangles
-                    .iter()
-                    .flat_map(|t| t.iter().flat_map(|p| p.coords.iter().copied()))
-                    .collect();
-                let normals: Vec<Real> = triangles
-                    .iter()
-                    .flat_map(|t| {
-                        let n: Vector3<Real> = (t[1] - t[0]).cross(&(t[2] - t[0])).normalize();
-                        [n.x, n.y, n.z]
-                    })
-                    .collect();
-                self.facets.write_at(device, 9 * first, &corners)?;
-                self.normals.write_at(device, 3 * first, &normals)?;
-            }
-            first += facets;
-        }
-        self.motion.write(device, &motion)
+        self.placed.update(device, &self.host.walls)
     }
 
     /// The particles' wall contacts, added to their forces and torques (after the
     /// pairs' gather), and the walls' sums into the readback, whose flag says
-    /// whether a particle had more than [`SLOTS`] wall contacts.
+    /// whether a particle had more than its slots of wall contacts.
     pub fn contacts(
         &mut self,
         device: &mut dyn Device,
         at: &WallInputs,
         readback: &Readback,
     ) -> Result<(), DeviceError> {
-        std::mem::swap(&mut self.old, &mut self.new);
-        let (old, new) = (&self.old, &self.new);
-        let walls = Arg::U32(self.host.walls.len() as u32);
-        // SAFETY: the parameters of sphere_walls (walls.cu), every
-        // array sized for its particles, slots, walls or facets.
+        self.slots.turn();
         readback.clear_flag(device)?;
-        unsafe {
-            run(
-                device,
-                Kernel::SphereWalls,
-                at.n,
-                &[
-                    Arg::U32(at.n as u32),
-                    Arg::F64(at.dt),
-                    at.position.arg(),
-                    at.velocity.arg(),
-                    at.orientation.arg(),
-                    at.angular_momentum.arg(),
-                    at.body_type.arg(),
-                    at.role.arg(),
-                    at.type_radius.arg(),
-                    at.type_mass.arg(),
-                    at.type_inertia.arg(),
-                    at.type_material.arg(),
-                    Arg::U32(at.materials),
-                    at.material_pairs.arg(),
-                    walls,
-                    self.wall_facets.arg(),
-                    self.facets.arg(),
-                    self.normals.arg(),
-                    self.material.arg(),
-                    self.motion.arg(),
-                    old.count.arg(),
-                    old.keys.arg(),
-                    old.springs.arg(),
-                    new.count.arg(),
-                    new.keys.arg(),
-                    new.springs.arg(),
-                    self.records.arg(),
-                    self.record_facet.arg(),
-                    at.force.arg(),
-                    at.torque.arg(),
-                    at.touching.arg(),
-                    readback.flag(),
-                ],
-            )?;
-        }
-        // The walls' sums: rows of partial sums over every so-many particles, folded.
+        let n = at.states.len();
         let width = self.sums_width();
-        let rows = wall_sum_rows(at.n, width);
-        let partials = self.sums.rows(device, rows, width)?;
-        // SAFETY: the parameters of wall_sum_rows (walls.cu): the slots hold n
-        // particles', `partials` room for `rows` rows of `width`.
-        unsafe {
-            run(
-                device,
-                Kernel::WallSumRows,
-                rows,
-                &[
-                    Arg::U32(at.n as u32),
-                    at.position.arg(),
-                    walls,
-                    self.wall_facets.arg(),
-                    self.motion.arg(),
-                    new.count.arg(),
-                    new.keys.arg(),
-                    self.records.arg(),
-                    self.record_facet.arg(),
-                    Arg::U32(rows as u32),
-                    partials.arg(),
-                ],
-            )?;
+        let rows = wall_sum_rows(n, width);
+        match (&at.law, &mut self.patches) {
+            (WallLaw::Volume(types), Some(patches)) => {
+                // SAFETY: the patches' arrays sized for the states' particles.
+                unsafe {
+                    patches.launch_find(
+                        device,
+                        types,
+                        &at.states,
+                        &self.placed,
+                        readback.flag(),
+                    )?;
+                }
+                let (walls, slots) = (&self.placed, &self.slots);
+                polyhedron_wall_contacts(
+                    device, types, &at.states, walls, patches, slots, &at.loads, at.dt,
+                )?;
+                let partials = self.sums.rows(device, rows, width)?;
+                // SAFETY: `partials` has room for `rows` rows of the walls' width;
+                // the patches and slots hold the particles' of `at`.
+                unsafe {
+                    let position = at.states.position;
+                    polyhedron_wall_sum_rows(
+                        device, position, walls, patches, slots, rows, partials,
+                    )?;
+                }
+            }
+            (WallLaw::Hertz { .. }, None) => {
+                self.sphere_contacts(device, at, readback)?;
+                let partials = self.sums.rows(device, rows, width)?;
+                let (walls, new) = (&self.placed, &self.slots.new);
+                // SAFETY: the parameters of wall_sum_rows (walls.cu): the slots hold n
+                // particles', `partials` room for `rows` rows of `width`.
+                unsafe {
+                    run(
+                        device,
+                        Kernel::WallSumRows,
+                        rows,
+                        &[
+                            Arg::U32(n as u32),
+                            at.states.position.arg(),
+                            walls.count_arg(),
+                            walls.wall_facets.arg(),
+                            walls.motion.arg(),
+                            new.count.arg(),
+                            new.keys.arg(),
+                            self.slots.records.arg(),
+                            self.slots.record_index.arg(),
+                            Arg::U32(rows as u32),
+                            partials.arg(),
+                        ],
+                    )?;
+                }
+            }
+            _ => {
+                return Err(DeviceError::Capacity(
+                    "wall contacts of a law the walls were not made for".into(),
+                ));
+            }
         }
         self.sums
             .fold(device, rows, width, &readback.device, readback::WALLS)
+    }
+
+    /// The Hertz–Mindlin contacts of spheres with the walls (`sphere_walls` of
+    /// walls.cu), the readback's flag set where a sphere has too many.
+    fn sphere_contacts(
+        &self,
+        device: &mut dyn Device,
+        at: &WallInputs,
+        readback: &Readback,
+    ) -> Result<(), DeviceError> {
+        let WallLaw::Hertz {
+            type_radius,
+            type_mass,
+            type_inertia,
+            type_material,
+            materials,
+            material_pairs,
+        } = at.law
+        else {
+            unreachable!("called for spheres only");
+        };
+        let (s, w) = (&at.states, &self.placed);
+        let mut args = vec![
+            Arg::U32(s.len() as u32),
+            Arg::F64(at.dt),
+            s.position.arg(),
+            s.velocity.arg(),
+            s.orientation.arg(),
+            s.angular_momentum.arg(),
+            s.body_type.arg(),
+            s.role.arg(),
+            type_radius.arg(),
+            type_mass.arg(),
+            type_inertia.arg(),
+            type_material.arg(),
+            Arg::U32(materials),
+            material_pairs.arg(),
+            w.count_arg(),
+            w.wall_facets.arg(),
+            w.facets.arg(),
+            w.normals.arg(),
+            w.material.arg(),
+            w.motion.arg(),
+        ];
+        args.extend(self.slots.args());
+        args.extend([
+            at.loads.force.arg(),
+            at.loads.torque.arg(),
+            at.loads.touching.arg(),
+            readback.flag(),
+        ]);
+        // SAFETY: the parameters of sphere_walls (walls.cu), every array sized for
+        // its particles, slots, walls or facets.
+        unsafe { run(device, Kernel::SphereWalls, s.len(), &args) }
     }
 
     /// Doubles of the walls' sums: per wall its force and torque, per facet its
@@ -342,26 +291,7 @@ impl DeviceWalls {
         terms: &Array<Real>,
         first: usize,
     ) -> Result<(), DeviceError> {
-        // SAFETY: the parameters of wall_energy_terms (walls.cu); the slots hold n
-        // particles', `terms` room for records up to first + n.
-        unsafe {
-            run(
-                device,
-                Kernel::WallEnergyTerms,
-                n,
-                &[
-                    Arg::U32(n as u32),
-                    self.new.count.arg(),
-                    self.new.keys.arg(),
-                    self.records.arg(),
-                    self.old.count.arg(),
-                    self.old.keys.arg(),
-                    self.old.springs.arg(),
-                    Arg::U32(first as u32),
-                    terms.arg(),
-                ],
-            )
-        }
+        self.slots.energy_terms(device, n, terms, first)
     }
 
     /// Takes the walls' poses, velocities, motions and the clock from `world` and
@@ -374,57 +304,26 @@ impl DeviceWalls {
             mine.motion = theirs.motion.clone();
         }
         self.host.time = world.time;
-        self.upload_placement(device)
+        self.placed.update(device, &self.host.walls)
     }
 
-    /// Sets the patches' friction springs (sorted by key) as those of the last
+    /// Sets the contacts' tangential history (sorted by key) as that of the last
     /// evaluation, for particles of `ids` (ascending).
     pub fn set_history(
         &mut self,
         device: &mut dyn Device,
         ids: &[u64],
-        history: &[(WallKey, crate::contact::TangentialHistory)],
+        history: &[(WallKey, TangentialHistory)],
     ) -> Result<(), DeviceError> {
         if self.is_empty() {
             return Ok(());
         }
-        let n = ids.len();
-        let mut count = vec![0u32; n];
-        let mut keys = vec![0i64; KEY * SLOTS * n];
-        let mut springs = vec![0.0; SPRING * SLOTS * n];
-        for ((id, wall, plane), h) in history {
-            let Ok(i) = ids.binary_search(id) else {
-                continue;
-            };
-            let s = count[i] as usize;
-            if s == SLOTS {
-                return Err(too_many_wall_contacts());
-            }
-            let slot = SLOTS * i + s;
-            keys[KEY * slot] = *wall as i64;
-            keys[KEY * slot + 1..KEY * slot + KEY].copy_from_slice(plane);
-            springs[SPRING * slot..SPRING * slot + SPRING].copy_from_slice(&[
-                h.spring.x,
-                h.spring.y,
-                h.spring.z,
-                h.stiffness,
-            ]);
-            count[i] += 1;
-        }
-        self.new.count.write(device, &count)?;
-        self.new.keys.write(device, &keys)?;
-        self.new.springs.write(device, &springs)
+        self.slots.set_history(device, ids, history)
     }
 
     /// Wall contacts at the last evaluation.
     pub fn contact_count(&self, device: &dyn Device) -> Result<usize, DeviceError> {
-        Ok(self
-            .new
-            .count
-            .read(device)?
-            .iter()
-            .map(|&c| c as usize)
-            .sum())
+        self.slots.contact_count(device)
     }
 
     /// Copies the walls' poses and velocities, and their forces, torques and facet
@@ -446,27 +345,16 @@ impl DeviceWalls {
         }
     }
 
-    /// The patches' friction springs by key, for particles of `ids`.
+    /// The contacts' tangential history by key, for particles of `ids`, sorted
+    /// (empty histories left out).
     pub fn history(
         &self,
         device: &dyn Device,
         ids: &[u64],
-    ) -> Result<Vec<(WallKey, [Real; 4])>, DeviceError> {
-        let (count, keys) = (self.new.count.read(device)?, self.new.keys.read(device)?);
-        let springs = self.new.springs.read(device)?;
-        let mut out = Vec::new();
-        for (i, &c) in count.iter().enumerate() {
-            for s in 0..c as usize {
-                let slot = SLOTS * i + s;
-                let k = &keys[KEY * slot..KEY * slot + KEY];
-                let h = &springs[SPRING * slot..SPRING * slot + SPRING];
-                out.push((
-                    (ids[i], k[0] as u32, [k[1], k[2], k[3], k[4]]),
-                    [h[0], h[1], h[2], h[3]],
-                ));
-            }
+    ) -> Result<Vec<(WallKey, TangentialHistory)>, DeviceError> {
+        if self.is_empty() {
+            return Ok(Vec::new());
         }
-        out.sort_by_key(|e| e.0);
-        Ok(out)
+        self.slots.history(device, ids)
     }
 }

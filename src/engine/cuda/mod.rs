@@ -7,7 +7,7 @@
 //! A [`device::Device`] holds buffers and launches kernels: the CUDA driver
 //! ([`driver::CudaDevice`]) or the host executor ([`device::HostDevice`]), behind
 //! one interface, so the code that drives the kernels is the same on both.
-//! [`spheres::DeviceSpheres`] steps a world of Hertz–Mindlin spheres and walls on a
+//! [`stepper::DeviceWorld`] steps a world of Hertz–Mindlin spheres and walls on a
 //! device: integration, the candidate list (a hashed cell grid, pairs by prefix
 //! sum), the pair contacts with their tangential history, the gather, the wall
 //! contacts and the walls' sums; it gives the CPU backend's bits through the host
@@ -17,9 +17,12 @@ pub mod backend;
 pub mod device;
 mod device_list;
 pub mod device_polyhedra;
+pub mod device_states;
 mod device_sums;
 pub mod device_volume_contacts;
 pub mod device_wall_patches;
+pub mod device_wall_placement;
+pub mod device_wall_slots;
 mod device_walls;
 pub mod driver;
 pub mod host;
@@ -27,7 +30,7 @@ pub mod nvrtc;
 #[cfg(test)]
 mod polyhedra_tests;
 mod readback;
-pub mod spheres;
+pub mod stepper;
 
 /// A source file of `kernels/`.
 #[derive(Debug)]
@@ -226,11 +229,14 @@ pub enum Kernel {
     PolyhedronWallPatches,
     /// The volume law's contacts of each polyhedron's wall patches (`polyhedra.cu`).
     PolyhedronWallContacts,
+    /// The walls' forces, torques and facet forces of polyhedra, first pass
+    /// (`polyhedra.cu`).
+    PolyhedronWallSumRows,
 }
 
 impl Kernel {
     /// Every kernel.
-    pub const ALL: [Kernel; 34] = [
+    pub const ALL: [Kernel; 35] = [
         Kernel::KickDrift,
         Kernel::ClosingKick,
         Kernel::BinParticles,
@@ -265,6 +271,7 @@ impl Kernel {
         Kernel::PolyhedronFacets,
         Kernel::PolyhedronWallPatches,
         Kernel::PolyhedronWallContacts,
+        Kernel::PolyhedronWallSumRows,
     ];
 
     /// Its name in the source (`extern "C"`, so the PTX entry has it too).
@@ -304,6 +311,7 @@ impl Kernel {
             Kernel::PolyhedronFacets => "polyhedron_facets",
             Kernel::PolyhedronWallPatches => "polyhedron_wall_patches",
             Kernel::PolyhedronWallContacts => "polyhedron_wall_contacts",
+            Kernel::PolyhedronWallSumRows => "polyhedron_wall_sum_rows",
         }
     }
 
@@ -326,7 +334,8 @@ impl Kernel {
             | PolyhedronContacts
             | PolyhedronFacets
             | PolyhedronWallPatches
-            | PolyhedronWallContacts => 8,
+            | PolyhedronWallContacts
+            | PolyhedronWallSumRows => 8,
         };
         &FILES[index]
     }

@@ -7,8 +7,12 @@ use nalgebra::{Point3, Quaternion, UnitQuaternion, Vector3};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 
+use super::device::{Array, Device};
+use super::device_states::DeviceStates;
 use super::device_volume_contacts::*;
-use super::device_wall_patches::{DeviceWallPatches, PATCH_SLOTS, PolyhedronWallContacts};
+use super::device_wall_patches::{DeviceWallPatches, Loads, PATCH_SLOTS, polyhedron_wall_contacts};
+use super::device_wall_placement::PlacedWalls;
+use super::device_wall_slots::WallSlots;
 use crate::Real;
 use crate::contact::Material;
 use crate::contact::TangentialHistory;
@@ -122,7 +126,7 @@ fn volume_contacts_equal_the_cpu_pair_stage() {
     let mut device = HostDevice::new(64);
     let types = DeviceBodyTypes::upload(&mut device, &world, REGULARISATION_LENGTH).unwrap();
     let mut states = DeviceStates::default();
-    states.upload(&mut device, &world).unwrap();
+    states.upload(&mut device, &world.particles).unwrap();
     let list: Vec<(u32, u32)> = (0..pairs as u32).map(|k| (2 * k, 2 * k + 1)).collect();
     let mut contacts = VolumeContacts::default();
     contacts.set_pairs(&mut device, &list, &histories).unwrap();
@@ -257,22 +261,38 @@ fn pellets_on_walls(random: &mut Pcg64) -> World {
     world
 }
 
-/// The world's body types, states and walls on a host device, and its patches.
-fn on_device(world: &World) -> (HostDevice, DeviceBodyTypes, DeviceStates, DeviceWallPatches) {
+/// A world's body types, states and walls on a host device, and its patches.
+struct OnDevice {
+    device: HostDevice,
+    types: DeviceBodyTypes,
+    states: DeviceStates,
+    walls: PlacedWalls,
+    patches: DeviceWallPatches,
+}
+
+fn on_device(world: &World) -> OnDevice {
     let mut device = HostDevice::new(64);
     let types = DeviceBodyTypes::upload(&mut device, world, REGULARISATION_LENGTH).unwrap();
     let mut states = DeviceStates::default();
-    states.upload(&mut device, world).unwrap();
+    states.upload(&mut device, &world.particles).unwrap();
+    let walls = PlacedWalls::new(&mut device, &world.walls).unwrap();
     let mut patches = DeviceWallPatches::default();
-    patches.place_walls(&mut device, world).unwrap();
-    patches.find(&mut device, &types, &states).unwrap();
-    (device, types, states, patches)
+    (patches.find(&mut device, &types, &states.view(), &walls)).unwrap();
+    OnDevice {
+        device,
+        types,
+        states,
+        walls,
+        patches,
+    }
 }
 
 #[test]
 fn wall_patches_are_the_cpu_wall_stages_bit_for_bit() {
     let world = pellets_on_walls(&mut Pcg64::seed_from_u64(11));
-    let (device, _, _, patches) = on_device(&world);
+    let OnDevice {
+        device, patches, ..
+    } = on_device(&world);
     let found = patches.patches(&device).unwrap();
     let (mut touching, mut summed, mut sides) = (0, 0, 0);
     for (i, on_device) in found.iter().enumerate() {
@@ -296,7 +316,13 @@ fn wall_patches_are_the_cpu_wall_stages_bit_for_bit() {
 fn wall_contacts_are_the_cpu_wall_stages_bit_for_bit() {
     let mut random = Pcg64::seed_from_u64(13);
     let world = pellets_on_walls(&mut random);
-    let (mut device, types, states, patches) = on_device(&world);
+    let OnDevice {
+        mut device,
+        types,
+        states,
+        walls,
+        patches,
+    } = on_device(&world);
     // Springs of the step before: for most patches found, one of random stretch,
     // stiffness and twist; for some particles a spring of a plane not touched now.
     let found = patches.patches(&device).unwrap();
@@ -322,13 +348,46 @@ fn wall_contacts_are_the_cpu_wall_stages_bit_for_bit() {
             springs
         })
         .collect();
-    let mut contacts = PolyhedronWallContacts::default();
-    contacts.set_history(&mut device, &held).unwrap();
+    let n = world.particles.len();
+    let ids: Vec<u64> = (0..n as u64).collect();
+    let mut keyed: Vec<_> = (held.iter().enumerate())
+        .flat_map(|(i, springs)| {
+            springs
+                .iter()
+                .map(move |&(w, key, h)| ((i as u64, w, key), h))
+        })
+        .collect();
+    keyed.sort_by_key(|e| e.0);
+    let mut slots = WallSlots::new(&mut device, n, 5).unwrap();
+    slots.set_history(&mut device, &ids, &keyed).unwrap();
+    slots.turn();
+    let zeros = |device: &mut HostDevice, len| {
+        let mut a = Array::default();
+        a.write(device as &mut dyn Device, &vec![0.0; len]).unwrap();
+        a
+    };
+    let (force, torque) = (zeros(&mut device, 3 * n), zeros(&mut device, 3 * n));
+    let mut touching = Array::default();
+    touching.write(&mut device, &vec![0u8; n]).unwrap();
+    let loads = Loads {
+        force: &force,
+        torque: &torque,
+        touching: &touching,
+    };
     let dt = 2e-6;
-    contacts
-        .evaluate(&mut device, &types, &states, &patches, dt)
-        .unwrap();
-    let results = contacts.results(&device).unwrap();
+    let states = states.view();
+    polyhedron_wall_contacts(
+        &mut device,
+        &types,
+        &states,
+        &walls,
+        &patches,
+        &slots,
+        &loads,
+        dt,
+    )
+    .unwrap();
+    let results = slots.contacts(&device).unwrap();
     let mut laws = ContactLaws::default();
     laws.prepare(&world, REGULARISATION_LENGTH, RoundLaw::Volume);
     let (mut made, mut sliding) = (0, 0);

@@ -1,13 +1,16 @@
-//! A world of Hertz–Mindlin spheres stepped on a [`Device`]: the CPU backend's step
-//! (`engine/cpu`) with every stage a kernel and the state in device memory between
-//! steps. Through the host executor it gives the CPU backend's bits
-//! (`tests/cuda_spheres.rs`).
+//! A world stepped on a [`Device`]: Hertz–Mindlin spheres, or convex polyhedra
+//! under the volume law; the CPU backend's step (`engine/cpu`) with every stage a
+//! kernel and the state in device memory between steps. Through the host executor
+//! spheres give the CPU backend's bits (`tests/cuda_spheres.rs`); polyhedra its
+//! answers to round-off, as far as the CPU backend's own answers move when every
+//! coordinate is nudged by an ulp (`tests/cuda_polyhedra.rs`: the kernel clips the
+//! faces of an overlap afresh where the CPU evaluates a kept topology).
 //!
-//! A step is [`DeviceSpheres::step`]: the opening kick and drift, then the force
+//! A step is [`DeviceWorld::step`]: the opening kick and drift, then the force
 //! evaluation (the list checked and rebuilt with its history carried, the pair
 //! contacts, the gather), then the closing kick. Per step the host reads back one
 //! word (whether the list is stale) and, when it was rebuilt, the pair count; the
-//! particles come back by [`DeviceSpheres::download`].
+//! particles come back by [`DeviceWorld::download`].
 //!
 //! Walls (`device_walls.rs`) move on the host and are placed on the device; each
 //! particle's wall contacts follow its pairs' gather. The walls' forces and the
@@ -20,8 +23,9 @@
 //! are felt and not moved, get no force and no wall contacts, and the figures
 //! count the pairs the rank counts (`Particles::counts_pair`).
 //!
-//! What it does not take yet (refused by [`DeviceSpheres::new`]): polyhedra,
-//! rolling resistance, a fluid.
+//! What it does not take yet (refused by [`DeviceWorld::new`]): spheres and
+//! polyhedra in one world, spheres under a law other than Hertz–Mindlin without
+//! rolling resistance, polyhedra of more than 64 faces or vertices, a fluid.
 
 use nalgebra::{Point3, UnitQuaternion, Vector3};
 
@@ -32,8 +36,15 @@ mod transfer;
 use super::Kernel;
 use super::device::{Arg, Array, Device, DeviceError};
 use super::device_list::{DeviceList, ListInputs, run};
+use super::device_polyhedra::{MAX_SHAPE_PARTS, ShapeTableError};
+use super::device_states::{StateView, roles};
 use super::device_sums::{PairTerms, RowSums, sum_energies};
-use super::device_walls::{DeviceWalls, WallInputs, too_many_wall_contacts};
+use super::device_volume_contacts::{
+    DeviceBodyTypes, HISTORY as VOLUME_HISTORY, PairOutputs, polyhedron_contacts,
+};
+use super::device_wall_patches::Loads;
+use super::device_wall_slots::too_many_wall_contacts;
+use super::device_walls::{DeviceWalls, WallInputs, WallLaw};
 use super::readback::Readback;
 use crate::Real;
 use crate::contact::{RollingModel, pair_restitution};
@@ -41,20 +52,18 @@ use crate::engine::neighbours::automatic_skin;
 use crate::engine::{RoundLaw, StepParams};
 use crate::world::{Particles, World};
 
-/// Doubles of a pair's tangential history on the device: the spring and the
-/// stiffness it was stretched at.
+/// Doubles of a Hertz–Mindlin pair's tangential history on the device: the spring
+/// and the stiffness it was stretched at (the volume law's adds its twist:
+/// [`VOLUME_HISTORY`]).
 const HISTORY: usize = 4;
 /// Doubles of a pair's result (`kernels/spheres.cu`).
 const RESULT: usize = 9;
 /// Doubles of a pair's energy terms (`kernels/spheres.cu`).
 const PAIR_ENERGY: usize = 2;
-/// A particle's role byte (`kernels/contact.cuh`): frozen, a ghost, or both.
-const FROZEN_ROLE: u8 = 1;
-const GHOST_ROLE: u8 = 2;
 
 /// Why a world cannot be stepped on the device.
 #[derive(Debug, thiserror::Error)]
-pub enum SpheresError {
+pub enum StepperError {
     /// The world holds something the device stepper does not model yet.
     #[error("the cuda backend does not yet step {0}")]
     Unsupported(String),
@@ -63,18 +72,85 @@ pub enum SpheresError {
     Device(#[from] DeviceError),
 }
 
-/// Per body type and per pair of materials, what the kernels read.
-#[derive(Debug, Default)]
+/// Per body type, what integration and the list read: mass, principal moments,
+/// bounding radius; and the contact law's rows.
+#[derive(Debug)]
 struct TypeArrays {
     mass: Array<Real>,
     inertia: Array<Real>,
     radius: Array<Real>,
+    law: PairLaw,
+}
+
+/// The contact law of a world's pairs and wall contacts, with what it reads per
+/// body type and pair of materials.
+#[derive(Debug)]
+enum PairLaw {
+    /// Spheres under Hertz–Mindlin.
+    Hertz(HertzTypes),
+    /// Polyhedra under the volume law, with their shapes.
+    Volume(Box<DeviceBodyTypes>),
+}
+
+/// What the Hertz–Mindlin kernels read per body type and pair of materials.
+#[derive(Debug, Default)]
+struct HertzTypes {
     inverse_mass: Array<Real>,
     inverse_inertia: Array<Real>,
     material: Array<u32>,
     /// Row-major over (material 1, material 2): E*, G*, β, √(4G*/E*), μ.
     material_pairs: Array<Real>,
     materials: u32,
+}
+
+impl PairLaw {
+    /// Bytes of device memory held.
+    fn bytes(&self, d: &dyn Device) -> usize {
+        match self {
+            PairLaw::Hertz(h) => {
+                let doubles = [&h.inverse_mass, &h.inverse_inertia, &h.material_pairs];
+                doubles.iter().map(|a| a.bytes(d)).sum::<usize>() + h.material.bytes(d)
+            }
+            PairLaw::Volume(types) => types.bytes(d),
+        }
+    }
+}
+
+impl HertzTypes {
+    /// The rows of `world`'s sphere types, by the operations of
+    /// `engine::laws::ContactLaws::prepare`.
+    fn upload(d: &mut dyn Device, world: &World) -> Result<Self, DeviceError> {
+        let bodies = &world.body_types;
+        let mut types = HertzTypes::default();
+        types
+            .inverse_mass
+            .write(d, &bodies.iter().map(|t| 1.0 / t.mass).collect::<Vec<_>>())?;
+        types.inverse_inertia.write(
+            d,
+            &bodies.iter().map(|t| 1.0 / t.inertia.x).collect::<Vec<_>>(),
+        )?;
+        types.material.write(
+            d,
+            &bodies.iter().map(|t| t.material as u32).collect::<Vec<_>>(),
+        )?;
+        let mut rows = Vec::new();
+        for a in &world.materials {
+            for b in &world.materials {
+                let e = pair_restitution(a.restitution, b.restitution);
+                let h = crate::contact::HertzMindlinPair::new(a, b, e);
+                rows.extend([
+                    h.young,
+                    h.shear,
+                    h.beta,
+                    h.damping_ratio,
+                    0.5 * (a.friction + b.friction),
+                ]);
+            }
+        }
+        types.material_pairs.write(d, &rows)?;
+        types.materials = world.materials.len() as u32;
+        Ok(types)
+    }
 }
 
 /// The particles' state on the device, in the order of their ids (nalgebra's
@@ -109,9 +185,9 @@ struct PairArrays {
     touching: Array<u8>,
 }
 
-/// A world of spheres on a device (see the module).
+/// A world on a device (see the module).
 #[derive(Debug)]
-pub struct DeviceSpheres {
+pub struct DeviceWorld {
     device: Box<dyn Device>,
     n: usize,
     /// The host world's entry of each device slot: the entries in id order.
@@ -175,33 +251,37 @@ fn slots_of(order: &[usize]) -> Vec<u32> {
     slot_of
 }
 
-/// The role bytes of the host entries `order`.
-fn roles(p: &Particles, order: &[usize]) -> Vec<u8> {
-    let role = |i: usize| {
-        let ghost = if p.is_ghost(i) { GHOST_ROLE } else { 0 };
-        ghost | if p.frozen[i] { FROZEN_ROLE } else { 0 }
-    };
-    order.iter().map(|&i| role(i)).collect()
-}
-
-impl DeviceSpheres {
+impl DeviceWorld {
     /// Uploads `world` to `device`, checking that it holds only what the device
     /// stepper models (see the module).
     pub fn new(
         mut device: Box<dyn Device>,
         world: &World,
         params: &StepParams,
-    ) -> Result<Self, SpheresError> {
+    ) -> Result<Self, StepperError> {
         Self::check(world, params)?;
         let p = &world.particles;
-        let radii: Vec<Real> = world
-            .body_types
-            .iter()
-            .map(|t| t.shape.as_sphere().map_or(0.0, |s| s.radius))
+        let radii: Vec<Real> = (world.body_types.iter())
+            .map(|t| t.shape.circumradius())
             .collect();
         let d = device.as_mut();
-        let mut types = TypeArrays::default();
         let bodies = &world.body_types;
+        let polyhedra = bodies.iter().any(|t| t.shape.as_polyhedron().is_some());
+        let law = if polyhedra {
+            let types = DeviceBodyTypes::upload(d, world, params.regularisation_length);
+            PairLaw::Volume(Box::new(types.map_err(|e| match e {
+                ShapeTableError::Device(e) => StepperError::Device(e),
+                other => StepperError::Unsupported(other.to_string()),
+            })?))
+        } else {
+            PairLaw::Hertz(HertzTypes::upload(d, world)?)
+        };
+        let mut types = TypeArrays {
+            mass: Array::default(),
+            inertia: Array::default(),
+            radius: Array::default(),
+            law,
+        };
         types
             .mass
             .write(d, &bodies.iter().map(|t| t.mass).collect::<Vec<_>>())?;
@@ -210,44 +290,16 @@ impl DeviceSpheres {
             &vectors(&bodies.iter().map(|t| t.inertia).collect::<Vec<_>>()),
         )?;
         types.radius.write(d, &radii)?;
-        types
-            .inverse_mass
-            .write(d, &bodies.iter().map(|t| 1.0 / t.mass).collect::<Vec<_>>())?;
-        types.inverse_inertia.write(
-            d,
-            &bodies.iter().map(|t| 1.0 / t.inertia.x).collect::<Vec<_>>(),
-        )?;
-        types.material.write(
-            d,
-            &bodies.iter().map(|t| t.material as u32).collect::<Vec<_>>(),
-        )?;
-        // The rows of `engine::laws::ContactLaws::prepare`, by the same operations.
-        let mut rows = Vec::new();
-        for a in &world.materials {
-            for b in &world.materials {
-                let e = pair_restitution(a.restitution, b.restitution);
-                let h = crate::contact::HertzMindlinPair::new(a, b, e);
-                rows.extend([
-                    h.young,
-                    h.shear,
-                    h.beta,
-                    h.damping_ratio,
-                    0.5 * (a.friction + b.friction),
-                ]);
-            }
-        }
-        types.material_pairs.write(d, &rows)?;
-        types.materials = world.materials.len() as u32;
 
         let all_radii: Vec<Real> = p.body_type.iter().map(|&k| radii[k as usize]).collect();
         let skin = params.skin.unwrap_or_else(|| automatic_skin(&all_radii));
         let skin = if skin.is_finite() { skin.max(0.0) } else { 0.0 };
         let largest = radii.iter().copied().fold(0.0, Real::max);
         let list = DeviceList::new(skin, 2.0 * largest + skin);
-        let walls = DeviceWalls::new(d, world, p.len())?;
+        let walls = DeviceWalls::new(d, world, p.len(), polyhedra)?;
         let readback = Readback::new(d, walls.sums_width())?;
         let order = id_order(p);
-        let mut spheres = DeviceSpheres {
+        let mut stepper = DeviceWorld {
             device,
             n: p.len(),
             slot_of: slots_of(&order),
@@ -266,30 +318,42 @@ impl DeviceSpheres {
             sums: RowSums::default(),
             readback,
         };
-        spheres.upload_particles(world)?;
-        Ok(spheres)
+        stepper.upload_particles(world)?;
+        Ok(stepper)
     }
 
     /// Whether the stepper models `world` under `params`: `Err` names what it does
     /// not model yet.
-    pub fn check(world: &World, params: &StepParams) -> Result<(), SpheresError> {
-        let unsupported = |what: &str| Err(SpheresError::Unsupported(what.into()));
+    pub fn check(world: &World, params: &StepParams) -> Result<(), StepperError> {
+        let unsupported = |what: &str| Err(StepperError::Unsupported(what.into()));
+        if world.fluid.is_some() {
+            return unsupported("a fluid");
+        }
+        let shapes = || world.body_types.iter().map(|t| &t.shape);
+        let spheres = shapes().filter(|s| s.as_sphere().is_some()).count();
+        if spheres == 0 {
+            // Polyhedra only, under the volume law whatever the spheres' law.
+            for (t, shape) in shapes().enumerate() {
+                let p = shape.as_polyhedron().expect("no spheres");
+                let (vertices, faces) = (p.vertices().len(), p.face_count());
+                if vertices > MAX_SHAPE_PARTS || faces > MAX_SHAPE_PARTS {
+                    return unsupported(&format!(
+                        "body type {t}, a polyhedron of {vertices} vertices and {faces} faces \
+                         (at most {MAX_SHAPE_PARTS} of each)"
+                    ));
+                }
+            }
+            return Ok(());
+        }
+        if spheres < world.body_types.len() {
+            return unsupported("a mix of spheres and polyhedra");
+        }
         if params.round_law
             != (RoundLaw::HertzMindlin {
                 rolling: RollingModel::None,
             })
         {
             return unsupported("a law other than Hertz–Mindlin without rolling resistance");
-        }
-        if world.fluid.is_some() {
-            return unsupported("a fluid");
-        }
-        if world
-            .body_types
-            .iter()
-            .any(|t| t.shape.as_sphere().is_none())
-        {
-            return unsupported("polyhedra");
         }
         Ok(())
     }
@@ -309,7 +373,7 @@ impl DeviceSpheres {
         a.force.write(d, &vectors(&in_order(&p.force, order)))?;
         a.torque.write(d, &vectors(&in_order(&p.torque, order)))?;
         a.body_type.write(d, &in_order(&p.body_type, order))?;
-        a.role.write(d, &roles(p, order))?;
+        a.role.write(d, &roles(p, order.iter().copied()))?;
         a.id.write(d, &in_order(&p.id, order))?;
         a.cell_code.write(d, &in_order(&p.cell_code, order))?;
         a.touching.resize(d, p.len())?;
@@ -433,6 +497,7 @@ impl DeviceSpheres {
     pub fn forces(&mut self, dt: Real) -> Result<(), DeviceError> {
         let stale = self.is_stale()?;
         self.stale = None;
+        let width = self.history_width();
         let d = self.device.as_mut();
         let (p, t, pairs, list) = (
             &self.particles,
@@ -455,7 +520,7 @@ impl DeviceSpheres {
                 std::mem::swap(&mut pairs.history, &mut pairs.old_history);
             }
             list.build(d, &inputs)?;
-            pairs.history.resize(d, HISTORY * list.pair_count)?;
+            pairs.history.resize(d, width * list.pair_count)?;
             if list.old_pair_count == 0 {
                 pairs.old_history.resize(d, 0)?;
             }
@@ -467,7 +532,7 @@ impl DeviceSpheres {
                     list.pair_count,
                     &[
                         Arg::U32(list.pair_count as u32),
-                        Arg::U32(HISTORY as u32),
+                        Arg::U32(width as u32),
                         list.keys.arg(),
                         Arg::U32(list.old_pair_count as u32),
                         list.old_keys.arg(),
@@ -481,35 +546,55 @@ impl DeviceSpheres {
             pairs.touching.resize(d, list.pair_count)?;
         }
         let count = list.pair_count;
-        // SAFETY: the parameters of sphere_contacts and gather_forces (spheres.cu),
-        // every array sized for its pairs, particles or body types.
+        let states = p.view();
+        match &t.law {
+            PairLaw::Hertz(h) => {
+                // SAFETY: the parameters of sphere_contacts (spheres.cu), every array
+                // sized for its pairs, particles or body types.
+                unsafe {
+                    run(
+                        d,
+                        Kernel::SphereContacts,
+                        count,
+                        &[
+                            Arg::U32(count as u32),
+                            Arg::F64(dt),
+                            list.pairs.arg(),
+                            p.position.arg(),
+                            p.velocity.arg(),
+                            p.angular_momentum.arg(),
+                            p.body_type.arg(),
+                            p.role.arg(),
+                            t.radius.arg(),
+                            h.inverse_mass.arg(),
+                            h.inverse_inertia.arg(),
+                            h.material.arg(),
+                            Arg::U32(h.materials),
+                            h.material_pairs.arg(),
+                            pairs.history.arg(),
+                            pairs.results.arg(),
+                            pairs.terms.arg(),
+                            pairs.touching.arg(),
+                        ],
+                    )?;
+                }
+            }
+            PairLaw::Volume(types) => {
+                let out = PairOutputs {
+                    history: &pairs.history,
+                    results: &pairs.results,
+                    energies: &pairs.terms,
+                    touching: &pairs.touching,
+                };
+                // SAFETY: the states hold every particle of the list's pairs, the
+                // types every body type; the outputs sized for `count` pairs.
+                unsafe { polyhedron_contacts(d, types, &states, count, &list.pairs, &out, dt)? };
+            }
+        }
+        let g = self.gravity;
+        // SAFETY: the parameters of gather_forces (spheres.cu), every array sized
+        // for its pairs, particles or body types.
         unsafe {
-            run(
-                d,
-                Kernel::SphereContacts,
-                count,
-                &[
-                    Arg::U32(count as u32),
-                    Arg::F64(dt),
-                    list.pairs.arg(),
-                    p.position.arg(),
-                    p.velocity.arg(),
-                    p.angular_momentum.arg(),
-                    p.body_type.arg(),
-                    p.role.arg(),
-                    t.radius.arg(),
-                    t.inverse_mass.arg(),
-                    t.inverse_inertia.arg(),
-                    t.material.arg(),
-                    Arg::U32(t.materials),
-                    t.material_pairs.arg(),
-                    pairs.history.arg(),
-                    pairs.results.arg(),
-                    pairs.terms.arg(),
-                    pairs.touching.arg(),
-                ],
-            )?;
-            let g = self.gravity;
             run(
                 d,
                 Kernel::GatherForces,
@@ -533,24 +618,26 @@ impl DeviceSpheres {
             )?;
         }
         if !self.walls.is_empty() {
+            let law = match &t.law {
+                PairLaw::Hertz(h) => WallLaw::Hertz {
+                    type_radius: &t.radius,
+                    type_mass: &t.mass,
+                    type_inertia: &t.inertia,
+                    type_material: &h.material,
+                    materials: h.materials,
+                    material_pairs: &h.material_pairs,
+                },
+                PairLaw::Volume(types) => WallLaw::Volume(types),
+            };
             let at = WallInputs {
-                n: self.n,
                 dt,
-                position: &p.position,
-                velocity: &p.velocity,
-                orientation: &p.orientation,
-                angular_momentum: &p.angular_momentum,
-                body_type: &p.body_type,
-                role: &p.role,
-                type_radius: &t.radius,
-                type_mass: &t.mass,
-                type_inertia: &t.inertia,
-                type_material: &t.material,
-                materials: t.materials,
-                material_pairs: &t.material_pairs,
-                force: &p.force,
-                torque: &p.torque,
-                touching: &p.touching,
+                states,
+                law,
+                loads: Loads {
+                    force: &p.force,
+                    torque: &p.torque,
+                    touching: &p.touching,
+                },
             };
             self.walls.contacts(d, &at, &self.readback)?;
         }
@@ -572,5 +659,28 @@ impl DeviceSpheres {
             return Err(too_many_wall_contacts());
         }
         Ok(())
+    }
+
+    /// Doubles of a pair's tangential history: the spring and its stiffness, and
+    /// under the volume law the twist.
+    fn history_width(&self) -> usize {
+        match self.types.law {
+            PairLaw::Hertz(_) => HISTORY,
+            PairLaw::Volume(_) => VOLUME_HISTORY,
+        }
+    }
+}
+
+impl ParticleArrays {
+    /// The states as the contact kernels read them.
+    fn view(&self) -> StateView<'_> {
+        StateView {
+            position: &self.position,
+            orientation: &self.orientation,
+            velocity: &self.velocity,
+            angular_momentum: &self.angular_momentum,
+            body_type: &self.body_type,
+            role: &self.role,
+        }
     }
 }

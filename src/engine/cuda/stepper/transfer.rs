@@ -1,17 +1,17 @@
-//! What crosses between a [`DeviceSpheres`] and the host: the particles, the walls
+//! What crosses between a [`DeviceWorld`] and the host: the particles, the walls
 //! and the clock, the figures of the last evaluation, the contact history both ways,
 //! and the device memory it holds.
 
 use nalgebra::{Point3, Quaternion, UnitQuaternion, Vector3};
 
-use super::{DeviceSpheres, HISTORY, in_order, points, quaternions, roles, vectors};
+use super::{DeviceWorld, in_order, points, quaternions, roles, vectors};
 use crate::Real;
 use crate::contact::TangentialHistory;
 use crate::engine::backend::ContactHistory;
 use crate::engine::cuda::device::{Array, Device, DeviceError};
 use crate::world::World;
 
-impl DeviceSpheres {
+impl DeviceWorld {
     /// Bytes of device memory the stepper holds: particles, body types, the list,
     /// the pairs' history and results, the walls, and on a rank its halo and the
     /// scratch of its figures (buffers have room to grow by half).
@@ -28,9 +28,6 @@ impl DeviceSpheres {
             &t.mass,
             &t.inertia,
             &t.radius,
-            &t.inverse_mass,
-            &t.inverse_inertia,
-            &t.material_pairs,
             &q.history,
             &q.old_history,
             &q.results,
@@ -39,10 +36,8 @@ impl DeviceSpheres {
         let bytes = [&p.role, &p.touching, &q.touching];
         doubles.iter().map(|a| a.bytes(d)).sum::<usize>()
             + bytes.iter().map(|a| a.bytes(d)).sum::<usize>()
-            + [&p.body_type, &t.material]
-                .iter()
-                .map(|a| a.bytes(d))
-                .sum::<usize>()
+            + p.body_type.bytes(d)
+            + t.law.bytes(d)
             + p.id.bytes(d)
             + p.cell_code.bytes(d)
             + self.list.bytes(d)
@@ -91,12 +86,14 @@ impl DeviceSpheres {
     /// replaces): the pairs' is carried into the list at its next build (which
     /// this forces), the walls' patches into their slots.
     pub fn set_history(&mut self, history: &ContactHistory) -> Result<(), DeviceError> {
+        let width = self.history_width();
         let d = self.device.as_mut();
         let keys: Vec<u64> = history.pairs.iter().flat_map(|(k, _)| [k.0, k.1]).collect();
-        let springs: Vec<Real> = history
-            .pairs
-            .iter()
-            .flat_map(|(_, h)| [h.spring.x, h.spring.y, h.spring.z, h.stiffness])
+        let springs: Vec<Real> = (history.pairs.iter())
+            .flat_map(|(_, h)| {
+                let kept = [h.spring.x, h.spring.y, h.spring.z, h.stiffness, h.twist];
+                kept.into_iter().take(width)
+            })
             .collect();
         self.list.old_keys.write(d, &keys)?;
         self.list.old_pair_count = history.pairs.len();
@@ -132,9 +129,7 @@ impl DeviceSpheres {
         grow(d, &mut a.force, from, n, |r| vectors(&p.force[r]))?;
         grow(d, &mut a.torque, from, n, |r| vectors(&p.torque[r]))?;
         grow(d, &mut a.body_type, from, n, |r| p.body_type[r].to_vec())?;
-        grow(d, &mut a.role, from, n, |r| {
-            roles(p, &r.collect::<Vec<_>>())
-        })?;
+        grow(d, &mut a.role, from, n, |r| roles(p, r))?;
         grow(d, &mut a.id, from, n, |r| p.id[r].to_vec())?;
         grow(d, &mut a.cell_code, from, n, |r| p.cell_code[r].to_vec())?;
         a.touching.resize(d, n)?;
@@ -151,7 +146,7 @@ impl DeviceSpheres {
     pub fn motion_from_host(&mut self, world: &World) -> Result<(), DeviceError> {
         let (d, a, p) = (self.device.as_mut(), &mut self.particles, &world.particles);
         let order = &self.order;
-        a.role.write(d, &roles(p, order))?;
+        a.role.write(d, &roles(p, order.iter().copied()))?;
         a.velocity
             .write(d, &vectors(&in_order(&p.velocity, order)))?;
         a.angular_momentum
@@ -236,13 +231,15 @@ impl DeviceSpheres {
             (&self.list.keys, &self.pairs.history)
         };
         let (keys, history) = (keys.read(d)?, history.read(d)?);
+        let width = self.history_width();
         let pairs = keys
             .chunks_exact(2)
-            .zip(history.chunks_exact(HISTORY))
+            .zip(history.chunks_exact(width))
             .map(|(k, h)| {
                 let kept = TangentialHistory {
                     spring: Vector3::new(h[0], h[1], h[2]),
                     stiffness: h[3],
+                    twist: if width > 4 { h[4] } else { 0.0 },
                     ..Default::default()
                 };
                 ((k[0], k[1]), kept)
@@ -250,20 +247,7 @@ impl DeviceSpheres {
             .filter(|(_, h)| !h.is_empty())
             .collect();
         let ids = self.particles.id.read(d)?;
-        let walls = self
-            .walls
-            .history(d, &ids)?
-            .into_iter()
-            .map(|(key, h)| {
-                let kept = TangentialHistory {
-                    spring: Vector3::new(h[0], h[1], h[2]),
-                    stiffness: h[3],
-                    ..Default::default()
-                };
-                (key, kept)
-            })
-            .filter(|(_, h)| !h.is_empty())
-            .collect();
+        let walls = self.walls.history(d, &ids)?;
         Ok(ContactHistory { pairs, walls })
     }
 }

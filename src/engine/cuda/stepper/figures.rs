@@ -4,7 +4,7 @@
 
 use nalgebra::{Point3, Vector3};
 
-use super::DeviceSpheres;
+use super::DeviceWorld;
 use crate::Real;
 use crate::engine::cuda::Kernel;
 use crate::engine::cuda::device::{Arg, Array, DeviceError};
@@ -33,7 +33,7 @@ impl FigureSums {
     }
 }
 
-impl DeviceSpheres {
+impl DeviceWorld {
     /// The figures of the owned particles ([`RunFigures::of`] of the host world
     /// the particles would be copied to; the sums in a tree, round-off apart from
     /// its serial sums, the extrema and counts exact).
@@ -66,6 +66,7 @@ impl DeviceSpheres {
                     Arg::F64(g.y),
                     Arg::F64(g.z),
                     p.position.arg(),
+                    p.orientation.arg(),
                     p.velocity.arg(),
                     p.angular_momentum.arg(),
                     p.force.arg(),

@@ -4,7 +4,7 @@
 
 use nalgebra::{Point3, Quaternion, UnitQuaternion, Vector3};
 
-use super::DeviceSpheres;
+use super::DeviceWorld;
 use crate::Real;
 use crate::engine::cuda::Kernel;
 use crate::engine::cuda::device::{Arg, Array, DeviceError};
@@ -32,7 +32,7 @@ impl HaloArrays {
     }
 }
 
-impl DeviceSpheres {
+impl DeviceWorld {
     /// Copies the motion state (position, orientation, velocity, angular momentum)
     /// of the host entries `entries` (owned particles sent as ghosts) into `world`.
     pub fn states_to_host(
