@@ -4,7 +4,8 @@
 //! GPU), the halo crossing between device and host every step, and every particle
 //! moves as one process on the CPU backend moves it, to the bit; and a whole
 //! [`Simulation`] on ranks of devices (as `mpirun talus run` makes one) pours
-//! spheres from an inlet into a box as one process does.
+//! spheres from an inlet into a box as one process does, and polyhedra as one
+//! process does to round-off (the device's overlaps are the CPU's to round-off).
 //!
 //! Its own MPI program (no libtest harness, as `mpi_ranks.rs`): started by `cargo
 //! test`, it launches itself under `mpirun` with `TALUS_MPI_RANK` set.
@@ -98,6 +99,7 @@ fn launch_ranks() -> Result<(), String> {
 fn run_rank() {
     let (_universe, exchange) = mpi_exchange::start().expect("MPI starts once");
     let poured = pour_on_ranks(exchange.another());
+    let rocks = rocks_on_ranks(exchange.another());
     let (rank, size) = (exchange.rank(), exchange.size());
     let scene = Scene::parse(
         &format!("{GLASS_AND_STEEL_SPHERES}{PARTICLES}"),
@@ -212,7 +214,8 @@ fn run_rank() {
         println!(
             "{size} ranks on devices: {n} spheres as one process, to the bit, \
              {arrived} changed rank, {} renewals, {ghosts} ghosts, up to {most_contacts} \
-             contacts; a pour from an inlet as one process ({poured} spheres)",
+             contacts; a pour from an inlet as one process ({poured} spheres); a pour of \
+             polyhedra as one process to round-off ({rocks})",
             ranked.renewals()
         );
     }
@@ -290,4 +293,52 @@ fn pour_on_ranks(exchange: Box<dyn Ranks>) -> usize {
     let inserted = one.world().particles.len() - scene.world.particles.len();
     assert_eq!(inserted, 120, "the inlet's particles");
     one.world().particles.len()
+}
+
+/// A pour of cubes onto dodecahedra in a box (the scene of `tests/cuda_polyhedra.rs`).
+const ROCKS: &str = include_str!("scenes/rock_pour.toml");
+
+/// The pour of polyhedra as a whole simulation on ranks of devices (host
+/// executors) against one process on the CPU backend, 1000 steps: at every 250th
+/// the contact counts are one process's, and the whole world gathered on rank 0
+/// holds one process's particles within 1e-8 of the dodecahedra's circumradius
+/// (`tests/cuda_polyhedra.rs` measures the drift of one device: 1e-10, as far as
+/// the CPU's own under a nudge of an ulp). Returns a report of the largest
+/// difference.
+fn rocks_on_ranks(exchange: Box<dyn Ranks>) -> String {
+    let scene = Scene::parse(ROCKS, Path::new("rock_pour.toml")).expect("a valid scene");
+    let mut one = Simulation::new(&scene);
+    let device = ShareBackend::Cuda(Box::new(HostDevice::new(64)));
+    let mut ranks = Simulation::on_ranks(&scene, device, exchange);
+    assert_eq!(ranks.backend().name(), "cuda");
+    let (mut worst, mut most) = (0.0 as Real, 0);
+    for step in 1..=1000 {
+        one.step();
+        ranks.step();
+        if step % 250 != 0 {
+            continue;
+        }
+        let (s, t) = (one.stats(), ranks.stats());
+        assert_eq!(
+            (s.contacts, s.pair_contacts),
+            (t.contacts, t.pair_contacts),
+            "step {step}"
+        );
+        most = most.max(s.contacts);
+        ranks.sync_particles();
+        let Some(whole) = ranks.whole_world() else {
+            continue;
+        };
+        let (a, b) = (&one.world().particles, &whole.particles);
+        assert_eq!(a.len(), b.len(), "step {step}");
+        for i in 0..a.len() {
+            let j = b.index_of(a.id[i]).expect("the same particles");
+            worst = worst.max((a.position[i] - b.position[j]).norm() / 0.005);
+        }
+        assert!(worst < 1e-8, "step {step}: {worst:e}");
+    }
+    format!(
+        "{} polyhedra, up to {most} contacts, within {worst:.1e} of a size",
+        one.world().particles.len()
+    )
 }
