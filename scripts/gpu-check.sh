@@ -2,7 +2,8 @@
 # On a machine with an NVIDIA GPU and its driver: the kernels compiled by NVRTC, the
 # parity tests on the real device (a missing driver or NVRTC fails instead of
 # skipping), and `talus bench --backend cuda` on the sphere scenes at 5000, 100 000
-# and a million spheres. Under five minutes with the binaries built.
+# and a million spheres and on the settled bed of dodecahedra at 10 000 and, tiled, a
+# million. Under five minutes with the binaries built.
 #   scripts/gpu-check.sh              builds the `cuda` feature with cargo, then runs
 #   scripts/gpu-check.sh BIN_DIR      runs binaries built elsewhere (a GPU machine
 #                                     without Rust): BIN_DIR holds `talus` and the
@@ -14,8 +15,9 @@
 # turning drum on GPU 0 against the CPU backend, the particles to the bit and the
 # sums to 1e-12 (tests/cuda_spheres.rs, `on_a_gpu_...`); the backend under a whole
 # simulation through the host executor (tests/cuda_backend.rs); the polyhedra's
-# overlaps and facet overlaps on GPU 0 against the CPU's (tests/cuda_polyhedra.rs,
-# `on_a_gpu_...`); the benchmark.
+# overlaps and facet overlaps on GPU 0 against the CPU's, and a pour and a drum of
+# polyhedra stepped on GPU 0 against the CPU backend to round-off
+# (tests/cuda_polyhedra.rs, `on_a_gpu_...`); the benchmark.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 nvidia-smi --query-gpu=name,driver_version,memory.total --format=csv,noheader
@@ -50,3 +52,5 @@ bench="$talus bench --backend cuda --threads 1"
 $bench --scene b,c --steps 400
 $bench --scene c --scale 20 --steps 300
 $bench --scene c --scale 200 --steps 100
+$bench --scene a --steps 200
+$bench --scene a --scale 100 --steps 50

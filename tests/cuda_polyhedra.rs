@@ -268,16 +268,20 @@ fn facet_overlaps(device: &mut dyn Device) {
 
 /// The same comparisons on a GPU, where there is one (`scripts/gpu-check.sh`): the
 /// kernels are compiled without fused multiply–adds and with IEEE division and
-/// square roots, so the facets and the flush cubes give the CPU's bits there too.
-/// Without a driver the test says so and passes, unless `TALUS_REQUIRE_GPU` is set.
+/// square roots, so the facets and the flush cubes give the CPU's bits there too;
+/// then the pour and the drum of polyhedra stepped on the GPU against the CPU
+/// backend. Without a driver the test says so and passes, unless
+/// `TALUS_REQUIRE_GPU` is set.
 #[test]
-fn on_a_gpu_overlaps_and_facet_overlaps_are_the_cpus() {
+fn on_a_gpu_overlaps_facet_overlaps_and_steps_are_the_cpus() {
     match CudaDevice::open(0) {
         Ok(mut gpu) => {
             eprintln!("on {gpu:?}");
             overlaps_at_random_poses(&mut gpu);
             flush_cubes(&mut gpu);
             facet_overlaps(&mut gpu);
+            pour_of_polyhedra(Box::new(gpu));
+            polyhedra_in_a_turning_drum(Box::new(CudaDevice::open(0).unwrap()));
         }
         Err(e) => {
             assert!(
@@ -301,12 +305,11 @@ struct Drift {
     most: (usize, usize),
 }
 
-/// `steps` steps of `scene` on the CPU backend, the CUDA backend and the CPU
-/// backend nudged, compared at every hundredth step (particles by id); the
+/// `steps` steps of `scene` on the CPU backend, the CUDA backend on `device` and
+/// the CPU backend nudged, compared at every hundredth step (particles by id); the
 /// contacts must be the same in number (pairs and walls) at each.
-fn drift(scene: &Scene, steps: usize, size: f64) -> Drift {
+fn drift(device: Box<dyn Device>, scene: &Scene, steps: usize, size: f64) -> Drift {
     let mut cpu = Simulation::new(scene);
-    let device = Box::new(HostDevice::new(64));
     let backend = CudaBackend::new(device, &scene.world, scene.step_params()).unwrap();
     let mut gpu = Simulation::with_backend(scene, Box::new(backend));
     let mut nudged_scene = scene.clone();
@@ -404,12 +407,16 @@ fn differences(a: &World, b: &World, size: f64) -> [f64; 4] {
 /// impact amplifies as it amplifies the CPU's own.
 #[test]
 fn a_pour_of_polyhedra_runs_as_on_the_cpu_backend_to_round_off() {
+    pour_of_polyhedra(Box::new(HostDevice::new(64)));
+}
+
+fn pour_of_polyhedra(device: Box<dyn Device>) {
     let mut scene = Scene::parse(ROCKS, Path::new("rock_pour.toml")).unwrap();
     let p = &mut scene.world.particles;
     for k in (3..p.len()).step_by(7) {
         p.frozen[k] = true;
     }
-    let run = drift(&scene, 1000, 0.005);
+    let run = drift(device, &scene, 1000, 0.005);
     assert!(run.most.0 > 30 && run.most.1 > 10, "{:?}", run.most);
     run.within(1e-8);
 }
@@ -422,8 +429,12 @@ fn a_pour_of_polyhedra_runs_as_on_the_cpu_backend_to_round_off() {
 /// size, and the three runs go on as different draws of one flow.)
 #[test]
 fn polyhedra_in_a_turning_drum_run_as_on_the_cpu_backend_to_round_off() {
+    polyhedra_in_a_turning_drum(Box::new(HostDevice::new(32)));
+}
+
+fn polyhedra_in_a_turning_drum(device: Box<dyn Device>) {
     let scene = Scene::parse(DRUM, Path::new("drum.toml")).unwrap();
-    let run = drift(&scene, 3400, 0.004);
+    let run = drift(device, &scene, 3400, 0.004);
     assert!(run.most.0 > 50 && run.most.1 > 20, "{:?}", run.most);
     run.within(1e-8);
 }

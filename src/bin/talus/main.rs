@@ -174,7 +174,7 @@ enum Command {
         #[arg(long)]
         ranks: bool,
         /// The backend that steps the scenes: cpu, or cuda (feature `cuda`, a GPU:
-        /// the sphere scenes b and c, c under Hertz–Mindlin).
+        /// scenes a, b and c, c under Hertz–Mindlin).
         #[arg(long, default_value = "cpu", value_parser = str::parse::<talus::engine::choice::BackendKind>)]
         backend: talus::engine::choice::BackendKind,
         /// Instead of measuring, pour the settled bed of scene (a) and write its
