@@ -118,3 +118,45 @@ static __device__ RoundContact round_contact(double depth, Vec3 normal, Vec3 lev
     return c;
 }
 
+
+// What the Hertz–Mindlin contacts of spheres read: per body type its radius, 1/m,
+// 1/I and material; per pair of materials (row-major) E*, G*, β, √(4G*/E*) and the
+// friction coefficient (MATERIAL_DOUBLES).
+struct HertzTable {
+    const double* radius;
+    const double* inverse_mass;
+    const double* inverse_inertia;
+    const unsigned* material;
+    unsigned materials;
+    const double* material_pairs;
+};
+
+// The contact of spheres of types ti and tj at xi and xj, moving at vi and vj with
+// angular momenta li and lj, holding `before` (engine/cpu/hertz.rs, sphere_pair):
+// false where they do not overlap (or their centres coincide).
+static __device__ bool sphere_pair(const HertzTable& t, unsigned ti, unsigned tj, Vec3 xi,
+                                   Vec3 xj, Vec3 vi, Vec3 vj, Vec3 li, Vec3 lj, Spring before,
+                                   double dt, RoundContact* c) {
+    double ra = t.radius[ti], rb = t.radius[tj];
+    Vec3 d = sub(xj, xi);
+    double distance_squared = norm_squared(d);
+    double reach = ra + rb;
+    if (!(distance_squared < reach * reach) || distance_squared == 0.0) {
+        return false;
+    }
+    double distance = sqrt(distance_squared);
+    Vec3 normal = scale(d, 1.0 / distance);
+    double depth = reach - distance;
+    Vec3 lever_i = scale(normal, ra - 0.5 * depth);
+    Vec3 lever_j = scale(normal, -(rb - 0.5 * depth));
+    Vec3 wi = scale(li, t.inverse_inertia[ti]);
+    Vec3 wj = scale(lj, t.inverse_inertia[tj]);
+    Vec3 relative = sub(sub(add(vj, cross(wj, lever_j)), vi), cross(wi, lever_i));
+    Vec3 spin = sub(wj, wi);
+    double inverse_mass = t.inverse_mass[ti] + t.inverse_mass[tj];
+    const double* m =
+        t.material_pairs + MATERIAL_DOUBLES * (t.material[ti] * t.materials + t.material[tj]);
+    *c = round_contact(depth, normal, lever_j, relative, spin, inverse_mass, ra * rb / (ra + rb),
+                       m, before, dt);
+    return true;
+}

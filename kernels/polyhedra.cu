@@ -1,14 +1,16 @@
 // The contacts of convex polyhedra: `polyhedron_overlaps`, one thread per pair of
 // shapes, the exact overlap at its relative pose (overlap.cuh) as a record of
 // OVERLAP_DOUBLES (volume 0: apart); `polyhedron_contacts`, one thread per
-// candidate pair of particles, the overlap and the volume law's force
-// (volume_law.cuh); `polyhedron_facets`, one thread per particle shape and wall
+// candidate pair of particles of a world of polyhedra (spheres among them or not),
+// the overlap and the volume law's force (volume_law.cuh), or a sphere's
+// Hertz–Mindlin contact (contact.cuh, sphere_polyhedron.cuh); `polyhedron_facets`, one thread per particle shape and wall
 // triangle, the overlap with the prism under the triangle (facet.cuh);
 // `polyhedron_wall_patches`, one thread per particle, its patches against the walls
 // (wall_patches.cuh); `polyhedron_wall_contacts`, one thread per particle, the
 // volume law's contact of each patch; `polyhedron_wall_sum_rows`, what they push on
 // the walls and their facets. Compiled after vec.cuh, contact.cuh, body.cuh,
-// triangle.cuh, overlap.cuh, volume_law.cuh, facet.cuh and wall_patches.cuh.
+// triangle.cuh, overlap.cuh, sphere_polyhedron.cuh, volume_law.cuh, facet.cuh and
+// wall_patches.cuh.
 
 // A pose of B in A's frame: B's centroid (three doubles), then its orientation
 // (w, x, y, z).
@@ -33,16 +35,145 @@ extern "C" __global__ void polyhedron_overlaps(
                        records + OVERLAP_DOUBLES * k);
 }
 
-// One thread per candidate pair of polyhedra: where one of the two moves here
-// (is neither frozen nor a ghost), the overlap of their shapes (overlap.cuh) and,
-// where they overlap, their contact under the volume law (volume_law.cuh) into its
-// result, its history replaced by what the contact leaves; apart, a zero result and
-// history, and the friction spring's energy as dissipated (engine/cpu/pairs.rs,
-// engine/cpu/dispatch.rs pair_geometry, engine/cpu/forces.rs pair_force). The
-// result, energy terms and byte are spheres.cu's (the gather and the sums read both
-// alike). Per body type: its shape, mass, principal moments, whether they are
-// equal, its law row (volume_law.cuh) and material; per pair of materials
-// (row-major) its law row.
+// A body type without a shape in the table: a sphere.
+#define NO_SHAPE 0xffffffffu
+
+// What a pair's contact puts on the second particle (force, torque about its
+// centroid), the first's reaction torque, the energies, and the history it keeps.
+struct PairContact {
+    Vec3 force, torque;
+    Spring kept;
+    double twist, energy, dissipated;
+};
+
+// What the pair kernel reads of the particles.
+struct PairStates {
+    const double *position, *orientation, *velocity, *angular_momentum;
+    const unsigned* body_type;
+};
+
+// What the pair kernel reads of the body types beside the shapes: mass, principal
+// moments, whether equal, the volume law's rows (volume_law.cuh), material; per
+// pair of materials the volume law's row; the spheres' Hertz–Mindlin table.
+struct PairTypes {
+    const double *mass, *inertia;
+    const unsigned char* isotropic;
+    const double* law;
+    const unsigned* material;
+    unsigned materials;
+    const double* material_law;
+    const unsigned* shape;
+    HertzTable hertz;
+};
+
+// A particle's angular velocity (World::angular_velocity).
+static __device__ __forceinline__ Vec3 spin_of(const PairStates& s, const PairTypes& t, unsigned i,
+                                               unsigned ti, Quat q) {
+    return angular_velocity(q, load3(s.angular_momentum, i), load3(t.inertia, ti),
+                            t.isotropic[ti]);
+}
+
+// Particles i (a polyhedron) and j (a sphere), or the other way round where
+// `sphere_first`, under Hertz–Mindlin: the polyhedron is locally flat, the contact
+// at the sphere's cap (engine/cpu/pairs.rs, pair_contact; engine/cpu/dispatch.rs,
+// pair_geometry). False where apart.
+static __device__ bool cap_pair(const ShapeTable& table, const PairStates& s, const PairTypes& t,
+                                unsigned i, unsigned j, Spring before, double dt,
+                                PairContact* out) {
+    unsigned ti = s.body_type[i], tj = s.body_type[j];
+    bool sphere_first = t.shape[ti] == NO_SHAPE;
+    unsigned p = sphere_first ? j : i, q = sphere_first ? i : j;
+    unsigned tp = sphere_first ? tj : ti, tq = sphere_first ? ti : tj;
+    Vec3 xp = load3(s.position, p), xq = load3(s.position, q);
+    Quat qp = load_orientation(s.orientation, p);
+    double r = t.hertz.radius[tq];
+    CapContact cap;
+    // The sphere's centre in the polyhedron's frame (Isometry3::inverse_transform_point).
+    if (!sphere_polyhedron(table, t.shape[tp], rotate(conjugate(qp), sub(xq, xp)), r, &cap)) {
+        return false;
+    }
+    Vec3 normal = rotate(qp, cap.normal);
+    Vec3 point = add(rotate(qp, cap.point), xp);
+    if (sphere_first) {
+        normal = scale(normal, -1.0);
+    }
+    Vec3 xi = load3(s.position, i), xj = load3(s.position, j);
+    Quat qi = load_orientation(s.orientation, i), qj = load_orientation(s.orientation, j);
+    Vec3 wi = spin_of(s, t, i, ti, qi), wj = spin_of(s, t, j, tj, qj);
+    // RelativeMotion::of_pair.
+    Vec3 relative = sub(add(load3(s.velocity, j), cross(wj, sub(point, xj))),
+                        add(load3(s.velocity, i), cross(wi, sub(point, xi))));
+    double inverse_mass =
+        inverse_mass_at(qi, xi, t.mass[ti], load3(t.inertia, ti), point, normal) +
+        inverse_mass_at(qj, xj, t.mass[tj], load3(t.inertia, tj), point, normal);
+    const HertzTable& h = t.hertz;
+    const double* m =
+        h.material_pairs + MATERIAL_DOUBLES * (h.material[ti] * h.materials + h.material[tj]);
+    RoundContact c = round_contact(cap.depth, normal, sub(point, xj), relative, sub(wj, wi),
+                                   inverse_mass, r, m, before, dt);
+    *out = PairContact{c.force, c.torque, c.kept, 0.0, c.energy, c.dissipated};
+    return true;
+}
+
+// Polyhedra i and j under the volume law, holding `before` and `twist`
+// (engine/cpu/dispatch.rs pair_geometry, engine/cpu/forces.rs pair_force). False
+// where they do not overlap.
+static __device__ bool volume_pair(const ShapeTable& table, const PairStates& s,
+                                   const PairTypes& t, unsigned i, unsigned j, Spring before,
+                                   double twist, double dt, PairContact* out) {
+    unsigned ti = s.body_type[i], tj = s.body_type[j];
+    Vec3 xi = load3(s.position, i), xj = load3(s.position, j);
+    Quat qi = load_orientation(s.orientation, i), qj = load_orientation(s.orientation, j);
+    // B's pose in A's frame, as nalgebra's pi.inverse() * pj.
+    Quat inverse = conjugate(qi);
+    Vec3 tr = add(rotate(inverse, scale(xi, -1.0)), rotate(inverse, xj));
+    OverlapScratch scratch;
+    double o[OVERLAP_DOUBLES];
+    polyhedron_overlap(table, t.shape[ti], t.shape[tj], tr, qmul(inverse, qj), &scratch, o);
+    if (!(o[0] > 0.0)) {
+        return false;
+    }
+    VolumeGeometry g;
+    g.volume = o[0];
+    g.area = o[7];
+    g.depth = o[8];
+    g.normal = rotate(qi, load3(o + 4, 0));
+    g.point = add(rotate(qi, load3(o + 1, 0)), xi);
+    g.rotation_gradient = rotate(qi, load3(o + 12, 0));
+    g.has_gradient = true;
+    const double* law_i = t.law + TYPE_LAW_DOUBLES * ti;
+    const double* law_j = t.law + TYPE_LAW_DOUBLES * tj;
+    Vec3 wi = spin_of(s, t, i, ti, qi), wj = spin_of(s, t, j, tj, qj);
+    VolumeMotion m;
+    m.velocity = sub(add(load3(s.velocity, j), cross(wj, sub(g.point, xj))),
+                     add(load3(s.velocity, i), cross(wi, sub(g.point, xi))));
+    m.spin = sub(wj, wi);
+    m.inverse_mass =
+        inverse_mass_at(qi, xi, t.mass[ti], load3(t.inertia, ti), g.point, g.normal) +
+        inverse_mass_at(qj, xj, t.mass[tj], load3(t.inertia, tj), g.point, g.normal);
+    m.inertia = 1.0 / (law_i[4] + law_j[4]);
+    // The smaller regularisation volume (that of the smaller body), the first's on a tie.
+    const double* regular = law_j[2] < law_i[2] ? law_j : law_i;
+    const double* material =
+        t.material_law + MATERIAL_LAW_DOUBLES * (t.material[ti] * t.materials + t.material[tj]);
+    VolumeContact c = volume_contact(g, m, law_i[0] + law_j[0], law_i[1] + law_j[1], regular[2],
+                                     regular[3], material, before, twist, dt, xj);
+    *out = PairContact{c.force, c.torque, c.kept, c.twist, c.energy, c.dissipated};
+    return true;
+}
+
+// One thread per candidate pair of a world of polyhedra, spheres among them or
+// not: where one of the two moves here (is neither frozen nor a ghost), two
+// polyhedra under the volume law (volume_pair), two spheres (contact.cuh,
+// sphere_pair) and a sphere and a polyhedron (cap_pair) under Hertz–Mindlin, into
+// the pair's result, its history replaced by what the contact leaves; apart, a zero
+// result and history, and the friction spring's energy as dissipated
+// (engine/cpu/pairs.rs). The result, energy terms and byte are spheres.cu's (the
+// gather and the sums read both alike); the history is VOLUME_HISTORY_DOUBLES,
+// whatever the pair. Per body type: its shape (NO_SHAPE: a sphere), mass,
+// principal moments, whether they are equal, its volume-law row and material; per
+// pair of materials (row-major) its volume-law row; and the spheres' Hertz–Mindlin
+// table (contact.cuh, HertzTable).
 extern "C" __global__ void polyhedron_contacts(
     unsigned pair_count, double dt, const unsigned* pairs, const double* position,
     const double* orientation, const double* velocity, const double* angular_momentum,
@@ -51,7 +182,9 @@ extern "C" __global__ void polyhedron_contacts(
     const unsigned* type_material, unsigned materials, const double* material_law,
     const unsigned* type_shape, const unsigned* shape_index, const unsigned* face_span,
     const unsigned* loops, const Mask* face_masks, const double* vertices, const double* planes,
-    const double* circumradius, double* history, double* results, double* energies,
+    const double* circumradius, const double* type_radius, const double* type_inverse_mass,
+    const double* type_inverse_inertia, const unsigned* hertz_material, unsigned hertz_materials,
+    const double* material_pairs, double* history, double* results, double* energies,
     unsigned char* touching) {
     unsigned e = blockIdx.x * blockDim.x + threadIdx.x;
     if (e >= pair_count) {
@@ -59,27 +192,40 @@ extern "C" __global__ void polyhedron_contacts(
     }
     ShapeTable table =
         ShapeTable{shape_index, face_span, loops, face_masks, vertices, planes, circumradius};
+    PairStates states = PairStates{position, orientation, velocity, angular_momentum, body_type};
+    PairTypes types = PairTypes{
+        type_mass,   type_inertia,  type_isotropic,
+        type_law,    type_material, materials,
+        material_law, type_shape,
+        HertzTable{type_radius, type_inverse_mass, type_inverse_inertia, hertz_material,
+                   hertz_materials, material_pairs}};
     unsigned i = pairs[2 * e], j = pairs[2 * e + 1];
-    unsigned ti = body_type[i], tj = body_type[j];
-    Vec3 xi = load3(position, i), xj = load3(position, j);
-    Quat qi = load_orientation(orientation, i), qj = load_orientation(orientation, j);
-    // B's pose in A's frame, as nalgebra's pi.inverse() * pj.
-    Quat inverse = conjugate(qi);
-    Vec3 t = add(rotate(inverse, scale(xi, -1.0)), rotate(inverse, xj));
     double* h = history + VOLUME_HISTORY_DOUBLES * e;
     double* result = results + RESULT_DOUBLES * e;
     double* energy = energies + PAIR_ENERGY_DOUBLES * e;
     bool counted = counts_pair(role[i], role[j]);
     unsigned char counted_flag = counted ? PAIR_COUNTED : 0u;
-    double o[OVERLAP_DOUBLES];
-    o[0] = 0.0;
-    if (!(role[i] && role[j])) {
-        OverlapScratch scratch;
-        polyhedron_overlap(table, type_shape[ti], type_shape[tj], t, qmul(inverse, qj), &scratch,
-                           o);
-    }
     Spring before = Spring{load3(h, 0), h[3]};
-    if (!(o[0] > 0.0)) {
+    PairContact c;
+    bool touches = false;
+    if (!(role[i] && role[j])) {
+        unsigned ti = body_type[i], tj = body_type[j];
+        bool sphere_i = type_shape[ti] == NO_SHAPE, sphere_j = type_shape[tj] == NO_SHAPE;
+        if (sphere_i && sphere_j) {
+            RoundContact round;
+            touches = sphere_pair(types.hertz, ti, tj, load3(position, i), load3(position, j),
+                                  load3(velocity, i), load3(velocity, j),
+                                  load3(angular_momentum, i), load3(angular_momentum, j), before,
+                                  dt, &round);
+            c = PairContact{round.force, round.torque, round.kept, 0.0, round.energy,
+                            round.dissipated};
+        } else if (sphere_i || sphere_j) {
+            touches = cap_pair(table, states, types, i, j, before, dt, &c);
+        } else {
+            touches = volume_pair(table, states, types, i, j, before, h[4], dt, &c);
+        }
+    }
+    if (!touches) {
         for (unsigned k = 0; k < RESULT_DOUBLES; ++k) {
             result[k] = 0.0;
         }
@@ -92,32 +238,7 @@ extern "C" __global__ void polyhedron_contacts(
         }
         return;
     }
-    VolumeGeometry g;
-    g.volume = o[0];
-    g.area = o[7];
-    g.depth = o[8];
-    g.normal = rotate(qi, load3(o + 4, 0));
-    g.point = add(rotate(qi, load3(o + 1, 0)), xi);
-    g.rotation_gradient = rotate(qi, load3(o + 12, 0));
-    g.has_gradient = true;
-    const double* law_i = type_law + TYPE_LAW_DOUBLES * ti;
-    const double* law_j = type_law + TYPE_LAW_DOUBLES * tj;
-    Vec3 inertia_i = load3(type_inertia, ti), inertia_j = load3(type_inertia, tj);
-    Vec3 wi = angular_velocity(qi, load3(angular_momentum, i), inertia_i, type_isotropic[ti]);
-    Vec3 wj = angular_velocity(qj, load3(angular_momentum, j), inertia_j, type_isotropic[tj]);
-    VolumeMotion m;
-    m.velocity = sub(add(load3(velocity, j), cross(wj, sub(g.point, xj))),
-                     add(load3(velocity, i), cross(wi, sub(g.point, xi))));
-    m.spin = sub(wj, wi);
-    m.inverse_mass = inverse_mass_at(qi, xi, type_mass[ti], inertia_i, g.point, g.normal) +
-                     inverse_mass_at(qj, xj, type_mass[tj], inertia_j, g.point, g.normal);
-    m.inertia = 1.0 / (law_i[4] + law_j[4]);
-    // The smaller regularisation volume (that of the smaller body), the first's on a tie.
-    const double* regular = law_j[2] < law_i[2] ? law_j : law_i;
-    const double* material =
-        material_law + MATERIAL_LAW_DOUBLES * (type_material[ti] * materials + type_material[tj]);
-    VolumeContact c = volume_contact(g, m, law_i[0] + law_j[0], law_i[1] + law_j[1], regular[2],
-                                     regular[3], material, before, h[4], dt, xj);
+    Vec3 xi = load3(position, i), xj = load3(position, j);
     Vec3 reaction = scale(add(c.torque, cross(sub(xj, xi), c.force)), -1.0);
     store3(result, 0, c.force);
     store3(result, 1, reaction);
@@ -155,7 +276,8 @@ extern "C" __global__ void polyhedron_facets(
 
 // One thread per particle: its patches against every wall, in wall order, each
 // with its facets' shares (wall_patches.cuh; the facets as index within their
-// wall); none for a particle nobody here moves (frozen or a ghost). `overflow` is
+// wall); none for a sphere, nor for a particle nobody here moves (frozen or a
+// ghost). `overflow` is
 // set where a particle has more patches than WALL_SLOTS or a patch more facets
 // than SHARE_SLOTS. Per wall, its first facet (walls + 1 entries); per facet, its
 // triangle in world coordinates and its unit normal.
@@ -172,12 +294,12 @@ extern "C" __global__ void polyhedron_wall_patches(
         return;
     }
     patch_count[i] = 0;
-    if (role[i]) {
+    unsigned shape = type_shape[body_type[i]];
+    if (role[i] || shape == NO_SHAPE) {
         return;
     }
     ShapeTable table =
         ShapeTable{shape_index, face_span, loops, face_masks, vertices, planes, circumradius};
-    unsigned shape = type_shape[body_type[i]];
     Side side;
     Polygon poly;
     place_body(table, shape, &side);
@@ -320,15 +442,17 @@ extern "C" __global__ void polyhedron_wall_contacts(
     store3(torque, i, tq);
 }
 
-// The walls' sums of polyhedra, first pass (walls.cu's wall_sum_rows, which
-// sums.cu folds on): thread t of `groups` adds the wall contacts of particles t,
-// t + groups, … in that order into row t of `rows`: per wall its force and torque
-// about its reference point (6 doubles), then per facet its force (3 doubles), each
-// of a patch's facets its share of the patch's force.
+// The walls' sums of a world of polyhedra, spheres among them or not, first pass
+// (walls.cu's wall_sum_rows, which sums.cu folds on): thread t of `groups` adds the
+// wall contacts of particles t, t + groups, … in that order into row t of `rows`:
+// per wall its force and torque about its reference point (6 doubles), then per
+// facet its force (3 doubles), each of a polyhedron's patch's facets its share of
+// the patch's force, a sphere's facet (record_index: sphere_walls' facet) all of it.
 extern "C" __global__ void polyhedron_wall_sum_rows(
-    unsigned n, const double* position, unsigned walls, const unsigned* wall_facets,
+    unsigned n, const double* position, const unsigned* body_type, const unsigned* type_shape,
+    unsigned walls, const unsigned* wall_facets,
     const double* wall_motion, const unsigned* count, const long long* keys,
-    const double* records, const unsigned* record_patch, const unsigned* patch_shares,
+    const double* records, const unsigned* record_index, const unsigned* patch_shares,
     const unsigned* share_facet, const double* share_volume, unsigned groups, double* rows) {
     unsigned t = blockIdx.x * blockDim.x + threadIdx.x;
     if (t >= groups) {
@@ -351,7 +475,12 @@ extern "C" __global__ void polyhedron_wall_sum_rows(
             if (!(total > 0.0)) {
                 continue;
             }
-            unsigned patch = record_patch[slot];
+            if (type_shape[body_type[i]] == NO_SHAPE) {
+                unsigned facet = 2 * walls + record_index[slot];
+                store3(row, facet, sub(load3(row, facet), scale(f, total / total)));
+                continue;
+            }
+            unsigned patch = record_index[slot];
             for (unsigned k = 0; k < patch_shares[patch]; ++k) {
                 unsigned facet = 2 * walls + wall_facets[w] + share_facet[SHARE_SLOTS * patch + k];
                 double share = share_volume[SHARE_SLOTS * patch + k];

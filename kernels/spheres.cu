@@ -26,21 +26,21 @@ extern "C" __global__ void sphere_contacts(
     if (e >= pair_count) {
         return;
     }
+    HertzTable table = HertzTable{type_radius, type_inverse_mass, type_inverse_inertia,
+                                  type_material, materials, material_pairs};
     unsigned i = pairs[2 * e], j = pairs[2 * e + 1];
     bool counted = counts_pair(role[i], role[j]);
     unsigned char counted_flag = counted ? PAIR_COUNTED : 0u;
-    unsigned ti = body_type[i], tj = body_type[j];
-    double ra = type_radius[ti], rb = type_radius[tj];
     Spring before = Spring{load3(history + HISTORY_DOUBLES * e, 0),
                            history[HISTORY_DOUBLES * e + 3]};
     double* result = results + RESULT_DOUBLES * e;
     double* energy = energies + PAIR_ENERGY_DOUBLES * e;
     Vec3 xi = load3(position, i), xj = load3(position, j);
-    Vec3 d = sub(xj, xi);
-    double distance_squared = norm_squared(d);
-    double reach = ra + rb;
-    bool contact = !(role[i] && role[j]) && distance_squared < reach * reach &&
-                   distance_squared != 0.0;
+    RoundContact c;
+    bool contact = !(role[i] && role[j]) &&
+                   sphere_pair(table, body_type[i], body_type[j], xi, xj, load3(velocity, i),
+                               load3(velocity, j), load3(angular_momentum, i),
+                               load3(angular_momentum, j), before, dt, &c);
     if (!contact) {
         bool held = before.spring.x != 0.0 || before.spring.y != 0.0 || before.spring.z != 0.0;
         for (unsigned k = 0; k < RESULT_DOUBLES; ++k) {
@@ -58,34 +58,17 @@ extern "C" __global__ void sphere_contacts(
         }
         return;
     }
-    double distance = sqrt(distance_squared);
-    Vec3 normal = scale(d, 1.0 / distance);
-    double depth = reach - distance;
-    Vec3 lever_i = scale(normal, ra - 0.5 * depth);
-    Vec3 lever_j = scale(normal, -(rb - 0.5 * depth));
-    Vec3 wi = scale(load3(angular_momentum, i), type_inverse_inertia[ti]);
-    Vec3 wj = scale(load3(angular_momentum, j), type_inverse_inertia[tj]);
-    Vec3 relative = sub(sub(add(load3(velocity, j), cross(wj, lever_j)), load3(velocity, i)),
-                        cross(wi, lever_i));
-    Vec3 spin = sub(wj, wi);
-    double inverse_mass = type_inverse_mass[ti] + type_inverse_mass[tj];
-    const double* m =
-        material_pairs + MATERIAL_DOUBLES * (type_material[ti] * materials + type_material[tj]);
-    RoundContact c = round_contact(depth, normal, lever_j, relative, spin, inverse_mass,
-                                   ra * rb / (ra + rb), m, before, dt);
-    Vec3 force = c.force, torque = c.torque;
-    Spring kept = c.kept;
-    Vec3 reaction = scale(add(torque, cross(sub(xj, xi), force)), -1.0);
-    store3(result, 0, force);
+    Vec3 reaction = scale(add(c.torque, cross(sub(xj, xi), c.force)), -1.0);
+    store3(result, 0, c.force);
     store3(result, 1, reaction);
-    store3(result, 2, torque);
+    store3(result, 2, c.torque);
     energy[0] = counted ? c.energy : 0.0;
     energy[1] = counted ? c.dissipated : 0.0;
     touching[e] = PAIR_TOUCHES | counted_flag;
-    history[HISTORY_DOUBLES * e] = kept.spring.x;
-    history[HISTORY_DOUBLES * e + 1] = kept.spring.y;
-    history[HISTORY_DOUBLES * e + 2] = kept.spring.z;
-    history[HISTORY_DOUBLES * e + 3] = kept.stiffness;
+    history[HISTORY_DOUBLES * e] = c.kept.spring.x;
+    history[HISTORY_DOUBLES * e + 1] = c.kept.spring.y;
+    history[HISTORY_DOUBLES * e + 2] = c.kept.spring.z;
+    history[HISTORY_DOUBLES * e + 3] = c.kept.stiffness;
 }
 
 // One thread per particle: its weight plus its pairs' forces in pair order (its

@@ -50,22 +50,25 @@ static __device__ __forceinline__ bool sphere_facet(const double* t, Vec3 centre
     return true;
 }
 
-// One thread per particle: its wall contacts (see the file's head), none for a
-// passive one (frozen or a ghost). `overflow` is set when a particle has more
-// than WALL_SLOTS contacts.
+// One thread per sphere: its wall contacts (see the file's head), none for a
+// passive one (frozen or a ghost); a particle of a type that is no sphere
+// (`type_sphere` 0) is left alone, its slots and load untouched (a world of
+// polyhedra and spheres: polyhedra.cu writes those). A slot's history is
+// `history_doubles` long (4, or 5 beside the volume law's, the twist 0).
+// `overflow` is set when a particle has more than WALL_SLOTS contacts.
 extern "C" __global__ void sphere_walls(
     unsigned n, double dt, const double* position, const double* velocity,
     const double* orientation, const double* angular_momentum, const unsigned* body_type,
-    const unsigned char* role, const double* type_radius, const double* type_mass,
-    const double* type_inertia, const unsigned* type_material, unsigned materials,
-    const double* material_pairs, unsigned walls, const unsigned* wall_facets,
+    const unsigned char* role, const unsigned char* type_sphere, const double* type_radius,
+    const double* type_mass, const double* type_inertia, const unsigned* type_material,
+    unsigned materials, const double* material_pairs, unsigned walls, const unsigned* wall_facets,
     const double* facets, const double* facet_normals, const unsigned* wall_material,
-    const double* wall_motion, const unsigned* old_count, const long long* old_keys,
-    const double* old_springs, unsigned* count, long long* keys, double* springs,
-    double* records, unsigned* record_facet, double* force, double* torque,
+    const double* wall_motion, unsigned history_doubles, const unsigned* old_count,
+    const long long* old_keys, const double* old_springs, unsigned* count, long long* keys,
+    double* springs, double* records, unsigned* record_facet, double* force, double* torque,
     unsigned char* touching, unsigned* overflow) {
     unsigned i = blockIdx.x * blockDim.x + threadIdx.x;
-    if (i >= n) {
+    if (i >= n || !type_sphere[body_type[i]]) {
         return;
     }
     count[i] = 0;
@@ -156,14 +159,17 @@ extern "C" __global__ void sphere_walls(
             Spring before = Spring{Vec3{0.0, 0.0, 0.0}, 0.0};
             unsigned held = held_slot(old_keys + KEY_WORDS * WALL_SLOTS * i, old_count[i], key);
             if (held < old_count[i]) {
-                const double* h = old_springs + HISTORY_DOUBLES * (WALL_SLOTS * i + held);
+                const double* h = old_springs + history_doubles * (WALL_SLOTS * i + held);
                 before = Spring{load3(h, 0), h[3]};
             }
             RoundContact c = round_contact(g.depth, g.normal, lever, relative,
                                            sub(spin, wall_spin), inverse_mass, r, m, before, dt);
-            double* h = springs + HISTORY_DOUBLES * (WALL_SLOTS * i + made);
+            double* h = springs + history_doubles * (WALL_SLOTS * i + made);
             store3(h, 0, c.kept.spring);
             h[3] = c.kept.stiffness;
+            for (unsigned k = HISTORY_DOUBLES; k < history_doubles; ++k) {
+                h[k] = 0.0;
+            }
             double* record = records + WALL_RECORD_DOUBLES * (WALL_SLOTS * i + made);
             store3(record, 0, c.force);
             store3(record, 1, c.torque);

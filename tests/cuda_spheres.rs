@@ -488,7 +488,8 @@ fn other_laws_are_refused() {
     let said = |r: Result<DeviceWorld, StepperError>| r.unwrap_err().to_string();
     assert_eq!(
         said(DeviceWorld::new(host(64), &world, &volume)),
-        "the cuda backend does not yet step a law other than Hertz–Mindlin without rolling resistance"
+        "the cuda backend does not yet step spheres under a law other than Hertz–Mindlin without \
+         rolling resistance"
     );
 }
 

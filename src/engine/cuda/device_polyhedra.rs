@@ -45,14 +45,6 @@ pub enum ShapeTableError {
         /// Its face count.
         faces: usize,
     },
-    /// A body type that is not a convex polyhedron.
-    #[error(
-        "body type {body_type} is not a convex polyhedron: the device's polyhedron contacts take polyhedra only"
-    )]
-    NotPolyhedron {
-        /// Its index.
-        body_type: usize,
-    },
     /// The device failed.
     #[error(transparent)]
     Device(#[from] DeviceError),

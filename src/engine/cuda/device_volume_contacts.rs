@@ -15,6 +15,7 @@ use nalgebra::Vector3;
 
 use super::Kernel;
 use super::device::{Arg, Array, Device, DeviceError};
+use super::device_hertz::HertzTypes;
 use super::device_polyhedra::{DeviceShapes, ShapeTableError};
 use super::device_states::{DeviceStates, StateView};
 use crate::Real;
@@ -24,6 +25,8 @@ use crate::engine::params::RoundLaw;
 use crate::geometry::{ConvexPolyhedron, is_isotropic};
 use crate::world::World;
 
+/// A sphere's shape index (`NO_SHAPE` of polyhedra.cu).
+pub(super) const NO_SHAPE: u32 = u32::MAX;
 /// Doubles of a body type's law row (`TYPE_LAW_DOUBLES` of volume_law.cuh).
 const TYPE_LAW: usize = 7;
 /// Doubles of a pair of materials' law row (`MATERIAL_LAW_DOUBLES`).
@@ -37,16 +40,20 @@ const PAIR_ENERGY: usize = 2;
 /// A pair's byte where it touches (`PAIR_TOUCHES`).
 const PAIR_TOUCHES: u8 = 1;
 
-/// The body types of a world of polyhedra and its pairs of materials on a device.
+/// The body types of a world of polyhedra (spheres among them or not) and its
+/// pairs of materials on a device.
 ///
 /// # Invariant
-/// Every body type is a polyhedron whose shape is in `shapes` at `shape[t]`; the
-/// law rows are those of the [`ContactLaws`] they were made from.
+/// Every polyhedron's shape is in `shapes` at `shape[t]`, a sphere's `shape[t]` is
+/// [`NO_SHAPE`]; the law rows are those of the [`ContactLaws`] they were made
+/// from, the Hertz–Mindlin table that of the same world.
 #[derive(Debug, Default)]
 pub struct DeviceBodyTypes {
     pub(super) shapes: DeviceShapes,
-    /// Per body type, its shape's index in `shapes`.
+    /// Per body type, its shape's index in `shapes` ([`NO_SHAPE`]: a sphere).
     pub(super) shape: Array<u32>,
+    /// The spheres' Hertz–Mindlin table.
+    pub(super) hertz: HertzTypes,
     mass: Array<Real>,
     /// Principal moments, three per type.
     inertia: Array<Real>,
@@ -80,6 +87,7 @@ impl DeviceBodyTypes {
     pub fn bytes(&self, device: &dyn Device) -> usize {
         let doubles = [&self.mass, &self.inertia, &self.law, &self.material_law];
         self.shapes.bytes(device)
+            + self.hertz.bytes(device)
             + doubles.iter().map(|a| a.bytes(device)).sum::<usize>()
             + self.shape.bytes(device)
             + self.material.bytes(device)
@@ -100,11 +108,11 @@ impl DeviceBodyTypes {
         let mut distinct: Vec<&ConvexPolyhedron> = Vec::new();
         let mut index_of: HashMap<*const ConvexPolyhedron, u32> = HashMap::new();
         let mut shape = Vec::new();
-        for (t, body) in world.body_types.iter().enumerate() {
-            let polyhedron = body
-                .shape
-                .as_polyhedron()
-                .ok_or(ShapeTableError::NotPolyhedron { body_type: t })?;
+        for body in &world.body_types {
+            let Some(polyhedron) = body.shape.as_polyhedron() else {
+                shape.push(NO_SHAPE);
+                continue;
+            };
             let k = *index_of.entry(polyhedron).or_insert_with(|| {
                 distinct.push(polyhedron);
                 distinct.len() as u32 - 1
@@ -139,6 +147,7 @@ impl DeviceBodyTypes {
         );
         let mut uploaded = DeviceBodyTypes {
             shapes: DeviceShapes::upload(device, &distinct)?,
+            hertz: HertzTypes::upload(device, world)?,
             material_count: laws.material_count() as u32,
             ..Default::default()
         };
@@ -214,6 +223,7 @@ pub(super) unsafe fn polyhedron_contacts(
     args.extend(types.law_args());
     args.push(types.shape.arg());
     args.extend(types.shapes.args());
+    args.extend(types.hertz.args());
     args.extend([
         out.history.arg(),
         out.results.arg(),

@@ -239,25 +239,36 @@ pub(super) fn polyhedron_wall_contacts(
     unsafe { device.launch(Kernel::PolyhedronWallContacts, n, &args) }
 }
 
-/// Launches the first pass of the walls' sums of polyhedra over `n` particles'
-/// contacts into `rows` rows (`polyhedron_wall_sum_rows` of polyhedra.cu).
+/// What the walls' sums of a world of polyhedra read: the particles' positions and
+/// body types, each body type's shape (`NO_SHAPE`: a sphere), the walls, the
+/// patches and the contacts' slots, all of the same particles.
+pub(super) struct PolyhedronSums<'a> {
+    pub states: &'a StateView<'a>,
+    pub shape: &'a Array<u32>,
+    pub walls: &'a PlacedWalls,
+    pub patches: &'a DeviceWallPatches,
+    pub slots: &'a WallSlots,
+}
+
+/// Launches the first pass of the walls' sums of a world of polyhedra (spheres
+/// among them or not) into `rows` rows (`polyhedron_wall_sum_rows` of
+/// polyhedra.cu).
 ///
 /// # Safety
 /// `partials` has room for `rows` rows of the walls' width (6 per wall, 3 per
-/// facet); the slots and patches hold the same `n` particles'.
+/// facet); the slots and patches hold the same particles' as the states.
 pub(super) unsafe fn polyhedron_wall_sum_rows(
     device: &mut dyn Device,
-    position: &Array<Real>,
-    walls: &PlacedWalls,
-    patches: &DeviceWallPatches,
-    slots: &WallSlots,
+    at: &PolyhedronSums,
     rows: usize,
     partials: &Array<Real>,
 ) -> Result<(), DeviceError> {
-    let n = position.len() / 3;
+    let (walls, patches, slots) = (at.walls, at.patches, at.slots);
     let args = [
-        Arg::U32(n as u32),
-        position.arg(),
+        Arg::U32(at.states.len() as u32),
+        at.states.position.arg(),
+        at.states.body_type.arg(),
+        at.shape.arg(),
         walls.count_arg(),
         walls.wall_facets.arg(),
         walls.motion.arg(),

@@ -105,6 +105,11 @@ impl WallSlots {
         self.record_index.resize(device, SLOTS * n)
     }
 
+    /// Doubles of a contact's history.
+    pub fn width(&self) -> usize {
+        self.width
+    }
+
     /// Makes the last evaluation's contacts the history of the next.
     pub fn turn(&mut self) {
         std::mem::swap(&mut self.old, &mut self.new);

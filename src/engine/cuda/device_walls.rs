@@ -13,12 +13,13 @@ use nalgebra::Vector3;
 
 use super::Kernel;
 use super::device::{Arg, Array, Device, DeviceError};
+use super::device_hertz::HertzTypes;
 use super::device_list::run;
 use super::device_states::StateView;
 use super::device_sums::{RowSums, first_rows};
 use super::device_volume_contacts::{DeviceBodyTypes, HISTORY as VOLUME_HISTORY};
 use super::device_wall_patches::{
-    DeviceWallPatches, Loads, polyhedron_wall_contacts, polyhedron_wall_sum_rows,
+    DeviceWallPatches, Loads, PolyhedronSums, polyhedron_wall_contacts, polyhedron_wall_sum_rows,
 };
 use super::device_wall_placement::PlacedWalls;
 use super::device_wall_slots::WallSlots;
@@ -42,28 +43,17 @@ fn wall_sum_rows(n: usize, width: usize) -> usize {
     (WALL_ROWS_DOUBLES / width.max(1)).clamp(1, first_rows(n))
 }
 
-/// What the particles' contacts with the walls follow.
-#[derive(Debug)]
-pub(super) enum WallLaw<'a> {
-    /// Hertz–Mindlin spheres: per body type its radius, mass, principal moments
-    /// and material, and per pair of materials its row (`kernels/walls.cu`).
-    Hertz {
-        type_radius: &'a Array<Real>,
-        type_mass: &'a Array<Real>,
-        type_inertia: &'a Array<Real>,
-        type_material: &'a Array<u32>,
-        materials: u32,
-        material_pairs: &'a Array<Real>,
-    },
-    /// Polyhedra under the volume law.
-    Volume(&'a DeviceBodyTypes),
-}
-
 /// What the wall contacts read and add to.
 pub(super) struct WallInputs<'a> {
     pub dt: Real,
     pub states: StateView<'a>,
-    pub law: WallLaw<'a>,
+    /// Per body type its mass and principal moments.
+    pub type_mass: &'a Array<Real>,
+    pub type_inertia: &'a Array<Real>,
+    /// The spheres' law (and every type's bounding radius).
+    pub hertz: &'a HertzTypes,
+    /// The polyhedra's law and shapes, where the world has polyhedra.
+    pub volume: Option<&'a DeviceBodyTypes>,
     pub loads: Loads<'a>,
 }
 
@@ -74,7 +64,9 @@ pub(super) struct DeviceWalls {
     host: World,
     placed: PlacedWalls,
     slots: WallSlots,
-    /// The patches of polyhedra (none for spheres).
+    /// Whether the world has spheres.
+    spheres: bool,
+    /// The patches of polyhedra (none without polyhedra).
     patches: Option<DeviceWallPatches>,
     /// Scratch of the walls' sums (folded into the readback: per wall its force
     /// and torque, then per facet its force).
@@ -82,14 +74,12 @@ pub(super) struct DeviceWalls {
 }
 
 impl DeviceWalls {
-    /// The walls of `world`, placed and uploaded, for `n` particles: spheres, or
-    /// where `polyhedra`, polyhedra under the volume law.
-    pub fn new(
-        device: &mut dyn Device,
-        world: &World,
-        n: usize,
-        polyhedra: bool,
-    ) -> Result<Self, DeviceError> {
+    /// The walls of `world`, placed and uploaded, for `n` particles: spheres
+    /// under Hertz–Mindlin, polyhedra under the volume law.
+    pub fn new(device: &mut dyn Device, world: &World, n: usize) -> Result<Self, DeviceError> {
+        let shapes = || world.body_types.iter().map(|t| &t.shape);
+        let spheres = shapes().any(|s| s.as_sphere().is_some());
+        let polyhedra = shapes().any(|s| s.as_polyhedron().is_some());
         let mut host = world.clone();
         host.particles = Default::default();
         host.fluid = None;
@@ -100,6 +90,7 @@ impl DeviceWalls {
         Ok(DeviceWalls {
             placed: PlacedWalls::new(device, &host.walls)?,
             slots: WallSlots::new(device, n, width)?,
+            spheres,
             patches: polyhedra.then(DeviceWallPatches::default),
             sums: RowSums::default(),
             host,
@@ -158,36 +149,39 @@ impl DeviceWalls {
         let n = at.states.len();
         let width = self.sums_width();
         let rows = wall_sum_rows(n, width);
-        match (&at.law, &mut self.patches) {
-            (WallLaw::Volume(types), Some(patches)) => {
-                // SAFETY: the patches' arrays sized for the states' particles.
-                unsafe {
-                    patches.launch_find(
-                        device,
-                        types,
-                        &at.states,
-                        &self.placed,
-                        readback.flag(),
-                    )?;
-                }
-                let (walls, slots) = (&self.placed, &self.slots);
-                polyhedron_wall_contacts(
-                    device, types, &at.states, walls, patches, slots, &at.loads, at.dt,
-                )?;
-                let partials = self.sums.rows(device, rows, width)?;
+        let walls = &self.placed;
+        // Each particle's contacts come from one kernel: a polyhedron's from the
+        // patches', a sphere's from sphere_walls, after (polyhedron_wall_contacts
+        // leaves a sphere no contact).
+        if let (Some(types), Some(patches)) = (at.volume, &mut self.patches) {
+            // SAFETY: the patches' arrays sized for the states' particles.
+            unsafe { patches.launch_find(device, types, &at.states, walls, readback.flag())? };
+            let (states, slots) = (&at.states, &self.slots);
+            polyhedron_wall_contacts(
+                device, types, states, walls, patches, slots, &at.loads, at.dt,
+            )?;
+        }
+        if self.spheres {
+            self.sphere_contacts(device, at, readback)?;
+        }
+        let partials = self.sums.rows(device, rows, width)?;
+        let (new, slots) = (&self.slots.new, &self.slots);
+        match (at.volume, &self.patches) {
+            (Some(types), Some(patches)) => {
                 // SAFETY: `partials` has room for `rows` rows of the walls' width;
                 // the patches and slots hold the particles' of `at`.
                 unsafe {
-                    let position = at.states.position;
-                    polyhedron_wall_sum_rows(
-                        device, position, walls, patches, slots, rows, partials,
-                    )?;
+                    let sums = PolyhedronSums {
+                        states: &at.states,
+                        shape: &types.shape,
+                        walls,
+                        patches,
+                        slots,
+                    };
+                    polyhedron_wall_sum_rows(device, &sums, rows, partials)?;
                 }
             }
-            (WallLaw::Hertz { .. }, None) => {
-                self.sphere_contacts(device, at, readback)?;
-                let partials = self.sums.rows(device, rows, width)?;
-                let (walls, new) = (&self.placed, &self.slots.new);
+            _ => {
                 // SAFETY: the parameters of wall_sum_rows (walls.cu): the slots hold n
                 // particles', `partials` room for `rows` rows of `width`.
                 unsafe {
@@ -203,18 +197,13 @@ impl DeviceWalls {
                             walls.motion.arg(),
                             new.count.arg(),
                             new.keys.arg(),
-                            self.slots.records.arg(),
-                            self.slots.record_index.arg(),
+                            slots.records.arg(),
+                            slots.record_index.arg(),
                             Arg::U32(rows as u32),
                             partials.arg(),
                         ],
                     )?;
                 }
-            }
-            _ => {
-                return Err(DeviceError::Capacity(
-                    "wall contacts of a law the walls were not made for".into(),
-                ));
             }
         }
         self.sums
@@ -229,18 +218,7 @@ impl DeviceWalls {
         at: &WallInputs,
         readback: &Readback,
     ) -> Result<(), DeviceError> {
-        let WallLaw::Hertz {
-            type_radius,
-            type_mass,
-            type_inertia,
-            type_material,
-            materials,
-            material_pairs,
-        } = at.law
-        else {
-            unreachable!("called for spheres only");
-        };
-        let (s, w) = (&at.states, &self.placed);
+        let (s, w, h) = (&at.states, &self.placed, at.hertz);
         let mut args = vec![
             Arg::U32(s.len() as u32),
             Arg::F64(at.dt),
@@ -250,18 +228,20 @@ impl DeviceWalls {
             s.angular_momentum.arg(),
             s.body_type.arg(),
             s.role.arg(),
-            type_radius.arg(),
-            type_mass.arg(),
-            type_inertia.arg(),
-            type_material.arg(),
-            Arg::U32(materials),
-            material_pairs.arg(),
+            h.sphere.arg(),
+            h.radius.arg(),
+            at.type_mass.arg(),
+            at.type_inertia.arg(),
+            h.material.arg(),
+            Arg::U32(h.materials),
+            h.material_pairs.arg(),
             w.count_arg(),
             w.wall_facets.arg(),
             w.facets.arg(),
             w.normals.arg(),
             w.material.arg(),
             w.motion.arg(),
+            Arg::U32(self.slots.width() as u32),
         ];
         args.extend(self.slots.args());
         args.extend([

@@ -15,6 +15,7 @@
 
 pub mod backend;
 pub mod device;
+mod device_hertz;
 mod device_list;
 pub mod device_polyhedra;
 pub mod device_states;
@@ -62,6 +63,13 @@ pub static CONTACT: KernelFile = KernelFile {
 pub static OVERLAP: KernelFile = KernelFile {
     name: "overlap.cuh",
     source: include_str!("../../../kernels/overlap.cuh"),
+    headers: &[],
+};
+
+/// The contact of a sphere with a convex polyhedron.
+pub static SPHERE_POLYHEDRON: KernelFile = KernelFile {
+    name: "sphere_polyhedron.cuh",
+    source: include_str!("../../../kernels/sphere_polyhedron.cuh"),
     headers: &[],
 };
 
@@ -151,6 +159,7 @@ pub static FILES: [KernelFile; 9] = [
             &BODY,
             &TRIANGLE,
             &OVERLAP,
+            &SPHERE_POLYHEDRON,
             &VOLUME_LAW,
             &FACET,
             &WALL_PATCHES,

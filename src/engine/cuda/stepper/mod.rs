@@ -1,5 +1,5 @@
-//! A world stepped on a [`Device`]: Hertz–Mindlin spheres, or convex polyhedra
-//! under the volume law; the CPU backend's step (`engine/cpu`) with every stage a
+//! A world stepped on a [`Device`]: Hertz–Mindlin spheres, convex polyhedra under
+//! the volume law, or both; the CPU backend's step (`engine/cpu`) with every stage a
 //! kernel and the state in device memory between steps. Through the host executor
 //! spheres give the CPU backend's bits (`tests/cuda_spheres.rs`); polyhedra its
 //! answers to round-off, as far as the CPU backend's own answers move when every
@@ -23,9 +23,12 @@
 //! are felt and not moved, get no force and no wall contacts, and the figures
 //! count the pairs the rank counts (`Particles::counts_pair`).
 //!
-//! What it does not take yet (refused by [`DeviceWorld::new`]): spheres and
-//! polyhedra in one world, spheres under a law other than Hertz–Mindlin without
-//! rolling resistance, polyhedra of more than 64 faces or vertices, a fluid.
+//! Spheres and polyhedra may share a world: two polyhedra meet under the volume
+//! law, a sphere meets anything under Hertz–Mindlin (a polyhedron as locally flat).
+//!
+//! What it does not take yet (refused by [`DeviceWorld::new`]): spheres under a law
+//! other than Hertz–Mindlin without rolling resistance, polyhedra of more than 64
+//! faces or vertices, a fluid.
 
 use nalgebra::{Point3, UnitQuaternion, Vector3};
 
@@ -35,6 +38,7 @@ mod transfer;
 
 use super::Kernel;
 use super::device::{Arg, Array, Device, DeviceError};
+use super::device_hertz::HertzTypes;
 use super::device_list::{DeviceList, ListInputs, run};
 use super::device_polyhedra::{MAX_SHAPE_PARTS, ShapeTableError};
 use super::device_states::{StateView, roles};
@@ -44,10 +48,10 @@ use super::device_volume_contacts::{
 };
 use super::device_wall_patches::Loads;
 use super::device_wall_slots::too_many_wall_contacts;
-use super::device_walls::{DeviceWalls, WallInputs, WallLaw};
+use super::device_walls::{DeviceWalls, WallInputs};
 use super::readback::Readback;
 use crate::Real;
-use crate::contact::{RollingModel, pair_restitution};
+use crate::contact::RollingModel;
 use crate::engine::neighbours::automatic_skin;
 use crate::engine::{RoundLaw, StepParams};
 use crate::world::{Particles, World};
@@ -72,84 +76,49 @@ pub enum StepperError {
     Device(#[from] DeviceError),
 }
 
-/// Per body type, what integration and the list read: mass, principal moments,
-/// bounding radius; and the contact law's rows.
+/// Per body type, what integration reads (mass, principal moments), and the
+/// contact laws' rows.
 #[derive(Debug)]
 struct TypeArrays {
     mass: Array<Real>,
     inertia: Array<Real>,
-    radius: Array<Real>,
     law: PairLaw,
 }
 
-/// The contact law of a world's pairs and wall contacts, with what it reads per
+/// The contact laws of a world's pairs and wall contacts, with what they read per
 /// body type and pair of materials.
 #[derive(Debug)]
 enum PairLaw {
     /// Spheres under Hertz–Mindlin.
     Hertz(HertzTypes),
-    /// Polyhedra under the volume law, with their shapes.
+    /// Polyhedra under the volume law with their shapes, and spheres among them
+    /// under Hertz–Mindlin.
     Volume(Box<DeviceBodyTypes>),
 }
 
-/// What the Hertz–Mindlin kernels read per body type and pair of materials.
-#[derive(Debug, Default)]
-struct HertzTypes {
-    inverse_mass: Array<Real>,
-    inverse_inertia: Array<Real>,
-    material: Array<u32>,
-    /// Row-major over (material 1, material 2): E*, G*, β, √(4G*/E*), μ.
-    material_pairs: Array<Real>,
-    materials: u32,
-}
-
 impl PairLaw {
+    /// The Hertz–Mindlin table: the spheres' law, and every type's bounding radius.
+    fn hertz(&self) -> &HertzTypes {
+        match self {
+            PairLaw::Hertz(h) => h,
+            PairLaw::Volume(types) => &types.hertz,
+        }
+    }
+
+    /// The volume law's rows and shapes, where the world has polyhedra.
+    fn volume(&self) -> Option<&DeviceBodyTypes> {
+        match self {
+            PairLaw::Hertz(_) => None,
+            PairLaw::Volume(types) => Some(types),
+        }
+    }
+
     /// Bytes of device memory held.
     fn bytes(&self, d: &dyn Device) -> usize {
         match self {
-            PairLaw::Hertz(h) => {
-                let doubles = [&h.inverse_mass, &h.inverse_inertia, &h.material_pairs];
-                doubles.iter().map(|a| a.bytes(d)).sum::<usize>() + h.material.bytes(d)
-            }
+            PairLaw::Hertz(h) => h.bytes(d),
             PairLaw::Volume(types) => types.bytes(d),
         }
-    }
-}
-
-impl HertzTypes {
-    /// The rows of `world`'s sphere types, by the operations of
-    /// `engine::laws::ContactLaws::prepare`.
-    fn upload(d: &mut dyn Device, world: &World) -> Result<Self, DeviceError> {
-        let bodies = &world.body_types;
-        let mut types = HertzTypes::default();
-        types
-            .inverse_mass
-            .write(d, &bodies.iter().map(|t| 1.0 / t.mass).collect::<Vec<_>>())?;
-        types.inverse_inertia.write(
-            d,
-            &bodies.iter().map(|t| 1.0 / t.inertia.x).collect::<Vec<_>>(),
-        )?;
-        types.material.write(
-            d,
-            &bodies.iter().map(|t| t.material as u32).collect::<Vec<_>>(),
-        )?;
-        let mut rows = Vec::new();
-        for a in &world.materials {
-            for b in &world.materials {
-                let e = pair_restitution(a.restitution, b.restitution);
-                let h = crate::contact::HertzMindlinPair::new(a, b, e);
-                rows.extend([
-                    h.young,
-                    h.shear,
-                    h.beta,
-                    h.damping_ratio,
-                    0.5 * (a.friction + b.friction),
-                ]);
-            }
-        }
-        types.material_pairs.write(d, &rows)?;
-        types.materials = world.materials.len() as u32;
-        Ok(types)
     }
 }
 
@@ -266,8 +235,7 @@ impl DeviceWorld {
             .collect();
         let d = device.as_mut();
         let bodies = &world.body_types;
-        let polyhedra = bodies.iter().any(|t| t.shape.as_polyhedron().is_some());
-        let law = if polyhedra {
+        let law = if bodies.iter().any(|t| t.shape.as_polyhedron().is_some()) {
             let types = DeviceBodyTypes::upload(d, world, params.regularisation_length);
             PairLaw::Volume(Box::new(types.map_err(|e| match e {
                 ShapeTableError::Device(e) => StepperError::Device(e),
@@ -279,7 +247,6 @@ impl DeviceWorld {
         let mut types = TypeArrays {
             mass: Array::default(),
             inertia: Array::default(),
-            radius: Array::default(),
             law,
         };
         types
@@ -289,14 +256,13 @@ impl DeviceWorld {
             d,
             &vectors(&bodies.iter().map(|t| t.inertia).collect::<Vec<_>>()),
         )?;
-        types.radius.write(d, &radii)?;
 
         let all_radii: Vec<Real> = p.body_type.iter().map(|&k| radii[k as usize]).collect();
         let skin = params.skin.unwrap_or_else(|| automatic_skin(&all_radii));
         let skin = if skin.is_finite() { skin.max(0.0) } else { 0.0 };
         let largest = radii.iter().copied().fold(0.0, Real::max);
         let list = DeviceList::new(skin, 2.0 * largest + skin);
-        let walls = DeviceWalls::new(d, world, p.len(), polyhedra)?;
+        let walls = DeviceWalls::new(d, world, p.len())?;
         let readback = Readback::new(d, walls.sums_width())?;
         let order = id_order(p);
         let mut stepper = DeviceWorld {
@@ -329,31 +295,27 @@ impl DeviceWorld {
         if world.fluid.is_some() {
             return unsupported("a fluid");
         }
-        let shapes = || world.body_types.iter().map(|t| &t.shape);
-        let spheres = shapes().filter(|s| s.as_sphere().is_some()).count();
-        if spheres == 0 {
-            // Polyhedra only, under the volume law whatever the spheres' law.
-            for (t, shape) in shapes().enumerate() {
-                let p = shape.as_polyhedron().expect("no spheres");
-                let (vertices, faces) = (p.vertices().len(), p.face_count());
-                if vertices > MAX_SHAPE_PARTS || faces > MAX_SHAPE_PARTS {
-                    return unsupported(&format!(
-                        "body type {t}, a polyhedron of {vertices} vertices and {faces} faces \
-                         (at most {MAX_SHAPE_PARTS} of each)"
-                    ));
-                }
+        for (t, body) in world.body_types.iter().enumerate() {
+            let Some(p) = body.shape.as_polyhedron() else {
+                continue;
+            };
+            let (vertices, faces) = (p.vertices().len(), p.face_count());
+            if vertices > MAX_SHAPE_PARTS || faces > MAX_SHAPE_PARTS {
+                return unsupported(&format!(
+                    "body type {t}, a polyhedron of {vertices} vertices and {faces} faces (at \
+                     most {MAX_SHAPE_PARTS} of each)"
+                ));
             }
-            return Ok(());
         }
-        if spheres < world.body_types.len() {
-            return unsupported("a mix of spheres and polyhedra");
-        }
-        if params.round_law
-            != (RoundLaw::HertzMindlin {
-                rolling: RollingModel::None,
-            })
-        {
-            return unsupported("a law other than Hertz–Mindlin without rolling resistance");
+        let spheres = (world.body_types.iter()).any(|t| t.shape.as_sphere().is_some());
+        // Polyhedra step under the volume law whatever the spheres' law.
+        let hertz = RoundLaw::HertzMindlin {
+            rolling: RollingModel::None,
+        };
+        if spheres && params.round_law != hertz {
+            return unsupported(
+                "spheres under a law other than Hertz–Mindlin without rolling resistance",
+            );
         }
         Ok(())
     }
@@ -512,7 +474,7 @@ impl DeviceWorld {
                 body_type: &p.body_type,
                 id: &p.id,
                 cell_code: &p.cell_code,
-                type_radius: &t.radius,
+                type_radius: &t.law.hertz().radius,
             };
             // The tangential history carried over by the pairs' ids: from this list,
             // or from a history set from outside.
@@ -549,35 +511,26 @@ impl DeviceWorld {
         let states = p.view();
         match &t.law {
             PairLaw::Hertz(h) => {
+                let mut args = vec![
+                    Arg::U32(count as u32),
+                    Arg::F64(dt),
+                    list.pairs.arg(),
+                    p.position.arg(),
+                    p.velocity.arg(),
+                    p.angular_momentum.arg(),
+                    p.body_type.arg(),
+                    p.role.arg(),
+                ];
+                args.extend(h.args());
+                args.extend([
+                    pairs.history.arg(),
+                    pairs.results.arg(),
+                    pairs.terms.arg(),
+                    pairs.touching.arg(),
+                ]);
                 // SAFETY: the parameters of sphere_contacts (spheres.cu), every array
                 // sized for its pairs, particles or body types.
-                unsafe {
-                    run(
-                        d,
-                        Kernel::SphereContacts,
-                        count,
-                        &[
-                            Arg::U32(count as u32),
-                            Arg::F64(dt),
-                            list.pairs.arg(),
-                            p.position.arg(),
-                            p.velocity.arg(),
-                            p.angular_momentum.arg(),
-                            p.body_type.arg(),
-                            p.role.arg(),
-                            t.radius.arg(),
-                            h.inverse_mass.arg(),
-                            h.inverse_inertia.arg(),
-                            h.material.arg(),
-                            Arg::U32(h.materials),
-                            h.material_pairs.arg(),
-                            pairs.history.arg(),
-                            pairs.results.arg(),
-                            pairs.terms.arg(),
-                            pairs.touching.arg(),
-                        ],
-                    )?;
-                }
+                unsafe { run(d, Kernel::SphereContacts, count, &args)? };
             }
             PairLaw::Volume(types) => {
                 let out = PairOutputs {
@@ -618,21 +571,13 @@ impl DeviceWorld {
             )?;
         }
         if !self.walls.is_empty() {
-            let law = match &t.law {
-                PairLaw::Hertz(h) => WallLaw::Hertz {
-                    type_radius: &t.radius,
-                    type_mass: &t.mass,
-                    type_inertia: &t.inertia,
-                    type_material: &h.material,
-                    materials: h.materials,
-                    material_pairs: &h.material_pairs,
-                },
-                PairLaw::Volume(types) => WallLaw::Volume(types),
-            };
             let at = WallInputs {
                 dt,
                 states,
-                law,
+                type_mass: &t.mass,
+                type_inertia: &t.inertia,
+                hertz: t.law.hertz(),
+                volume: t.law.volume(),
                 loads: Loads {
                     force: &p.force,
                     torque: &p.torque,

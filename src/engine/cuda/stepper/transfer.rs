@@ -27,7 +27,6 @@ impl DeviceWorld {
             &p.torque,
             &t.mass,
             &t.inertia,
-            &t.radius,
             &q.history,
             &q.old_history,
             &q.results,
