@@ -20,6 +20,7 @@ use talus::engine::cuda::device_polyhedra::{
     DeviceShapes, FacetQueries, PolyhedronPairs, ShapeTableError,
 };
 use talus::engine::cuda::driver::CudaDevice;
+use talus::engine::cuda::stepper::DeviceWorld;
 use talus::geometry::overlap::{OverlapGeometry, overlap};
 use talus::geometry::wall::polyhedron_triangle;
 use talus::geometry::{ConvexPolyhedron, Pose, generators};
@@ -535,3 +536,73 @@ min = [-0.06, 0.0, -0.03]
 max = [0.06, 0.012, 0.06]
 inside = { centre = [0.0, 0.006, 0.0], axis = [0.0, 1.0, 0.0], radius = 0.06, fill = 0.6 }
 "#;
+
+/// A world of polyhedra stepped on the device keeps its contact history (friction
+/// springs and twists, of pairs and wall patches) through a restore: a second
+/// stepper made from the first's particles and history reads back the same history
+/// and steps on to the same bits. The device memory it holds: per particle its
+/// state and list (230 bytes), four wall slots (histories of five doubles) and
+/// four patches with their facets' shares (about 2.3 kB), per candidate pair 217
+/// bytes (the pair, its incidences and ids, its history, result and energy terms,
+/// and the previous build's ids and histories), buffers with room to grow by half.
+#[test]
+fn polyhedra_on_the_device_keep_their_history_through_a_restore() {
+    // The lattice of dodecahedra falling into the box (the stepper alone runs no
+    // inlet).
+    let scene = Scene::parse(ROCKS, Path::new("rock_pour.toml")).unwrap();
+    let (params, dt) = (scene.step_params(), scene.dt);
+    let host = || Box::new(HostDevice::new(64));
+    let mut first = DeviceWorld::new(host(), &scene.world, &params).unwrap();
+    first.initialise(dt).unwrap();
+    for _ in 0..2500 {
+        first.step(dt).unwrap();
+    }
+    let history = first.contact_history().unwrap();
+    let twisted = history.pairs.iter().filter(|(_, h)| h.twist != 0.0).count();
+    assert!(history.pairs.len() > 10 && twisted > 5, "{history:?}");
+    assert!(history.walls.iter().any(|(_, h)| h.twist != 0.0));
+    let mut world = scene.world.clone();
+    first.download(&mut world).unwrap();
+    let mut again = DeviceWorld::new(host(), &world, &params).unwrap();
+    again.set_history(&history).unwrap();
+    assert_eq!(again.contact_history().unwrap(), history);
+    // The forces of the last evaluation came with the particles: the restored
+    // stepper goes on without evaluating them again (which would stretch the
+    // springs twice).
+    for _ in 0..200 {
+        first.step(dt).unwrap();
+        again.step(dt).unwrap();
+    }
+    let (mut a, mut b) = (world.clone(), world);
+    first.download(&mut a).unwrap();
+    again.download(&mut b).unwrap();
+    assert_eq!(a.particles.position, b.particles.position);
+    assert_eq!(a.particles.angular_momentum, b.particles.angular_momentum);
+    assert_eq!(
+        first.contact_history().unwrap(),
+        again.contact_history().unwrap()
+    );
+
+    // The memory of 4000 dodecahedra on a lattice in a box of 20 cm: the fixed part
+    // (shapes, the walls' rows, the readback) spread thin.
+    let wide = ROCKS
+        .replace("max = [0.05, 0.05, 0.2]", "max = [0.2, 0.2, 0.2]")
+        .replace("max = [0.05, 0.05, 0.025]", "max = [0.2, 0.2, 0.1]");
+    let scene = Scene::parse(&wide, Path::new("rock_pour.toml")).unwrap();
+    let mut lattice = DeviceWorld::new(host(), &scene.world, &params).unwrap();
+    lattice.initialise(dt).unwrap();
+    let n = scene.world.particles.len() as f64;
+    let pairs = lattice.candidate_pairs() as f64;
+    let bytes = lattice.device_bytes() as f64;
+    let each = (bytes - 217.0 * pairs) / n;
+    eprintln!(
+        "{bytes} bytes of device memory for {n} polyhedra and {pairs} candidate pairs, with a \
+         box: {each:.0} bytes a particle beside 217 a pair"
+    );
+    assert!(n > 3000.0, "{n}");
+    assert!(bytes >= 2400.0 * n + 217.0 * pairs, "{bytes} bytes");
+    assert!(
+        bytes <= 1.5 * (2600.0 * n + 217.0 * pairs) + 65536.0,
+        "{bytes} bytes"
+    );
+}
