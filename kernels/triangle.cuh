@@ -82,3 +82,15 @@ static __device__ __forceinline__ void add_wall_reaction(double* row, unsigned w
     Vec3 reaction = scale(add(torque, cross(sub(x, reference), f)), -1.0);
     store3(row, 2 * w + 1, add(load3(row, 2 * w + 1), reaction));
 }
+
+// Row t of the walls' sums (per wall its force and torque, then per facet its
+// force: 6 doubles a wall, 3 a facet), zeroed.
+static __device__ __forceinline__ double* zeroed_wall_row(double* rows, unsigned t, unsigned walls,
+                                                          const unsigned* wall_facets) {
+    unsigned width = 6 * walls + 3 * wall_facets[walls];
+    double* row = rows + (size_t)width * t;
+    for (unsigned k = 0; k < width; ++k) {
+        row[k] = 0.0;
+    }
+    return row;
+}

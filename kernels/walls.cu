@@ -201,11 +201,7 @@ extern "C" __global__ void wall_sum_rows(unsigned n, const double* position, uns
     if (t >= groups) {
         return;
     }
-    unsigned width = 6 * walls + 3 * wall_facets[walls];
-    double* row = rows + (size_t)width * t;
-    for (unsigned k = 0; k < width; ++k) {
-        row[k] = 0.0;
-    }
+    double* row = zeroed_wall_row(rows, t, walls, wall_facets);
     for (unsigned i = t; i < n; i += groups) {
         Vec3 x = load3(position, i);
         for (unsigned s = 0; s < count[i]; ++s) {
