@@ -1,7 +1,9 @@
 // The Hertz–Mindlin law of round contacts with Cundall–Strack friction
-// (contact/hertz_mindlin.rs, contact/tangential.rs, engine/cpu/hertz.rs), shared by
-// the sphere pairs (spheres.cu) and the sphere–wall contacts (walls.cu): the CPU
-// backend's operations in its order. Compiled after vec.cuh.
+// (contact/hertz_mindlin.rs, contact/tangential.rs, engine/cpu/hertz.rs), the
+// contact of two spheres under it, and a spherical cap's volume and area, shared
+// by the pairs (spheres.cu, polyhedra.cu) and the sphere–wall contacts (walls.cu):
+// the CPU backend's operations in its order. The particles' roles and the pairs a
+// rank counts. Compiled after vec.cuh.
 
 #define HISTORY_DOUBLES 4u
 // A record of the energy sums (sums.cu): elastic energy, dissipated, wall contacts,
@@ -27,6 +29,20 @@ static __device__ __forceinline__ bool counts_pair(unsigned char ri, unsigned ch
     bool frozen_i = (ri & FROZEN_ROLE) != 0;
     bool ghost_i = (ri & GHOST_ROLE) != 0, ghost_j = (rj & GHOST_ROLE) != 0;
     return ghost_i ? frozen_i && !ghost_j : !(frozen_i && ghost_j);
+}
+
+// The volume of a spherical cap of height h on a sphere of radius r, and the area
+// of its base disc (geometry/sphere.rs, cap_volume and cap_area).
+static __device__ __forceinline__ double cap_volume(double r, double h) {
+    const double pi = 3.14159265358979323846;
+    h = fmin(fmax(h, 0.0), 2.0 * r);
+    return pi * h * h * (3.0 * r - h) / 3.0;
+}
+
+static __device__ __forceinline__ double cap_area(double r, double h) {
+    const double pi = 3.14159265358979323846;
+    h = fmin(fmax(h, 0.0), r);
+    return pi * (2.0 * r * h - h * h);
 }
 
 // 2 √(5/6), the factor of the damping coefficients.

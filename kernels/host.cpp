@@ -15,7 +15,7 @@ thread_local dim3 threadIdx, blockIdx, blockDim, gridDim;
 #include "body.cuh"
 #include "triangle.cuh"
 #include "overlap.cuh"
-#include "sphere_polyhedron.cuh"
+#include "round_geometry.cuh"
 #include "volume_law.cuh"
 #include "facet.cuh"
 #include "wall_patches.cuh"

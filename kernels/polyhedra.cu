@@ -1,15 +1,16 @@
 // The contacts of convex polyhedra: `polyhedron_overlaps`, one thread per pair of
 // shapes, the exact overlap at its relative pose (overlap.cuh) as a record of
 // OVERLAP_DOUBLES (volume 0: apart); `polyhedron_contacts`, one thread per
-// candidate pair of particles of a world of polyhedra (spheres among them or not),
+// candidate pair of particles of a world with polyhedra or under the volume law,
 // the overlap and the volume law's force (volume_law.cuh), or a sphere's
-// Hertz–Mindlin contact (contact.cuh, sphere_polyhedron.cuh); `polyhedron_facets`, one thread per particle shape and wall
-// triangle, the overlap with the prism under the triangle (facet.cuh);
+// contact under Hertz–Mindlin or the volume law (contact.cuh, round_geometry.cuh);
+// `polyhedron_facets`, one thread per particle shape and wall triangle, the
+// overlap with the prism under the triangle (facet.cuh);
 // `polyhedron_wall_patches`, one thread per particle, its patches against the walls
 // (wall_patches.cuh); `polyhedron_wall_contacts`, one thread per particle, the
 // volume law's contact of each patch; `polyhedron_wall_sum_rows`, what they push on
 // the walls and their facets. Compiled after vec.cuh, contact.cuh, body.cuh,
-// triangle.cuh, overlap.cuh, sphere_polyhedron.cuh, volume_law.cuh, facet.cuh and
+// triangle.cuh, overlap.cuh, round_geometry.cuh, volume_law.cuh, facet.cuh and
 // wall_patches.cuh.
 
 // A pose of B in A's frame: B's centroid (three doubles), then its orientation
@@ -73,54 +74,62 @@ static __device__ __forceinline__ Vec3 spin_of(const PairStates& s, const PairTy
                             t.isotropic[ti]);
 }
 
-// Particles i (a polyhedron) and j (a sphere), or the other way round where
-// `sphere_first`, under Hertz–Mindlin: the polyhedron is locally flat, the contact
-// at the sphere's cap (engine/cpu/pairs.rs, pair_contact; engine/cpu/dispatch.rs,
-// pair_geometry). False where apart.
-static __device__ bool cap_pair(const ShapeTable& table, const PairStates& s, const PairTypes& t,
-                                unsigned i, unsigned j, Spring before, double dt,
-                                PairContact* out) {
+// Particles i (a polyhedron) and j (a sphere), or the other way round where the
+// sphere comes first: their contact's geometry, the polyhedron locally flat, its
+// point at the sphere's cap (engine/cpu/dispatch.rs, pair_geometry). False where
+// apart.
+static __device__ bool cap_geometry(const ShapeTable& table, const PairStates& s,
+                                    const PairTypes& t, unsigned i, unsigned j,
+                                    VolumeGeometry* g) {
     unsigned ti = s.body_type[i], tj = s.body_type[j];
     bool sphere_first = t.shape[ti] == NO_SHAPE;
     unsigned p = sphere_first ? j : i, q = sphere_first ? i : j;
     unsigned tp = sphere_first ? tj : ti, tq = sphere_first ? ti : tj;
     Vec3 xp = load3(s.position, p), xq = load3(s.position, q);
     Quat qp = load_orientation(s.orientation, p);
-    double r = t.hertz.radius[tq];
     CapContact cap;
     // The sphere's centre in the polyhedron's frame (Isometry3::inverse_transform_point).
-    if (!sphere_polyhedron(table, t.shape[tp], rotate(conjugate(qp), sub(xq, xp)), r, &cap)) {
+    Vec3 c = rotate(conjugate(qp), sub(xq, xp));
+    if (!sphere_polyhedron(table, t.shape[tp], c, t.hertz.radius[tq], &cap)) {
         return false;
     }
-    Vec3 normal = rotate(qp, cap.normal);
-    Vec3 point = add(rotate(qp, cap.point), xp);
+    g->volume = cap.volume;
+    g->area = cap.area;
+    g->depth = cap.depth;
+    g->normal = rotate(qp, cap.normal);
+    g->point = add(rotate(qp, cap.point), xp);
+    g->has_gradient = false;
     if (sphere_first) {
-        normal = scale(normal, -1.0);
+        g->normal = scale(g->normal, -1.0);
     }
-    Vec3 xi = load3(s.position, i), xj = load3(s.position, j);
-    Quat qi = load_orientation(s.orientation, i), qj = load_orientation(s.orientation, j);
-    Vec3 wi = spin_of(s, t, i, ti, qi), wj = spin_of(s, t, j, tj, qj);
-    // RelativeMotion::of_pair.
-    Vec3 relative = sub(add(load3(s.velocity, j), cross(wj, sub(point, xj))),
-                        add(load3(s.velocity, i), cross(wi, sub(point, xi))));
-    double inverse_mass =
-        inverse_mass_at(qi, xi, t.mass[ti], load3(t.inertia, ti), point, normal) +
-        inverse_mass_at(qj, xj, t.mass[tj], load3(t.inertia, tj), point, normal);
-    const HertzTable& h = t.hertz;
-    const double* m =
-        h.material_pairs + MATERIAL_DOUBLES * (h.material[ti] * h.materials + h.material[tj]);
-    RoundContact c = round_contact(cap.depth, normal, sub(point, xj), relative, sub(wj, wi),
-                                   inverse_mass, r, m, before, dt);
-    *out = PairContact{c.force, c.torque, c.kept, 0.0, c.energy, c.dissipated};
     return true;
 }
 
-// Polyhedra i and j under the volume law, holding `before` and `twist`
-// (engine/cpu/dispatch.rs pair_geometry, engine/cpu/forces.rs pair_force). False
-// where they do not overlap.
-static __device__ bool volume_pair(const ShapeTable& table, const PairStates& s,
-                                   const PairTypes& t, unsigned i, unsigned j, Spring before,
-                                   double twist, double dt, PairContact* out) {
+// Spheres i and j: their lens (geometry/sphere.rs, sphere_sphere). False where
+// apart.
+static __device__ bool lens_geometry(const PairStates& s, const PairTypes& t, unsigned i,
+                                     unsigned j, VolumeGeometry* g) {
+    Vec3 xi = load3(s.position, i);
+    CapContact lens;
+    const double* radius = t.hertz.radius;
+    if (!sphere_sphere(radius[s.body_type[i]], radius[s.body_type[j]],
+                       sub(load3(s.position, j), xi), &lens)) {
+        return false;
+    }
+    g->volume = lens.volume;
+    g->area = lens.area;
+    g->depth = lens.depth;
+    g->normal = lens.normal;
+    g->point = add(xi, lens.point);
+    g->has_gradient = false;
+    return true;
+}
+
+// Polyhedra i and j: their overlap (overlap.cuh; engine/cpu/dispatch.rs,
+// pair_geometry). False where they do not overlap.
+static __device__ bool overlap_geometry(const ShapeTable& table, const PairStates& s,
+                                        const PairTypes& t, unsigned i, unsigned j,
+                                        VolumeGeometry* g) {
     unsigned ti = s.body_type[i], tj = s.body_type[j];
     Vec3 xi = load3(s.position, i), xj = load3(s.position, j);
     Quat qi = load_orientation(s.orientation, i), qj = load_orientation(s.orientation, j);
@@ -133,47 +142,121 @@ static __device__ bool volume_pair(const ShapeTable& table, const PairStates& s,
     if (!(o[0] > 0.0)) {
         return false;
     }
-    VolumeGeometry g;
-    g.volume = o[0];
-    g.area = o[7];
-    g.depth = o[8];
-    g.normal = rotate(qi, load3(o + 4, 0));
-    g.point = add(rotate(qi, load3(o + 1, 0)), xi);
-    g.rotation_gradient = rotate(qi, load3(o + 12, 0));
-    g.has_gradient = true;
-    const double* law_i = t.law + TYPE_LAW_DOUBLES * ti;
-    const double* law_j = t.law + TYPE_LAW_DOUBLES * tj;
+    g->volume = o[0];
+    g->area = o[7];
+    g->depth = o[8];
+    g->normal = rotate(qi, load3(o + 4, 0));
+    g->point = add(rotate(qi, load3(o + 1, 0)), xi);
+    g->rotation_gradient = rotate(qi, load3(o + 12, 0));
+    g->has_gradient = true;
+    return true;
+}
+
+// RelativeMotion::of_pair of particles i and j at the contact `g`, with the pair's
+// rotational inertia `inertia`.
+static __device__ VolumeMotion pair_motion(const PairStates& s, const PairTypes& t, unsigned i,
+                                           unsigned j, Vec3 point, Vec3 normal, double inertia) {
+    unsigned ti = s.body_type[i], tj = s.body_type[j];
+    Vec3 xi = load3(s.position, i), xj = load3(s.position, j);
+    Quat qi = load_orientation(s.orientation, i), qj = load_orientation(s.orientation, j);
     Vec3 wi = spin_of(s, t, i, ti, qi), wj = spin_of(s, t, j, tj, qj);
     VolumeMotion m;
-    m.velocity = sub(add(load3(s.velocity, j), cross(wj, sub(g.point, xj))),
-                     add(load3(s.velocity, i), cross(wi, sub(g.point, xi))));
+    m.velocity = sub(add(load3(s.velocity, j), cross(wj, sub(point, xj))),
+                     add(load3(s.velocity, i), cross(wi, sub(point, xi))));
     m.spin = sub(wj, wi);
-    m.inverse_mass =
-        inverse_mass_at(qi, xi, t.mass[ti], load3(t.inertia, ti), g.point, g.normal) +
-        inverse_mass_at(qj, xj, t.mass[tj], load3(t.inertia, tj), g.point, g.normal);
-    m.inertia = 1.0 / (law_i[4] + law_j[4]);
+    m.inverse_mass = inverse_mass_at(qi, xi, t.mass[ti], load3(t.inertia, ti), point, normal) +
+                     inverse_mass_at(qj, xj, t.mass[tj], load3(t.inertia, tj), point, normal);
+    m.inertia = inertia;
+    return m;
+}
+
+// The volume law's contact `g` of particles i and j, holding `before` and `twist`
+// (engine/cpu/forces.rs, pair_force).
+static __device__ PairContact volume_pair(const PairStates& s, const PairTypes& t, unsigned i,
+                                          unsigned j, const VolumeGeometry& g, Spring before,
+                                          double twist, double dt) {
+    unsigned ti = s.body_type[i], tj = s.body_type[j];
+    const double* law_i = t.law + TYPE_LAW_DOUBLES * ti;
+    const double* law_j = t.law + TYPE_LAW_DOUBLES * tj;
+    VolumeMotion m = pair_motion(s, t, i, j, g.point, g.normal, 1.0 / (law_i[4] + law_j[4]));
     // The smaller regularisation volume (that of the smaller body), the first's on a tie.
     const double* regular = law_j[2] < law_i[2] ? law_j : law_i;
     const double* material =
         t.material_law + MATERIAL_LAW_DOUBLES * (t.material[ti] * t.materials + t.material[tj]);
     VolumeContact c = volume_contact(g, m, law_i[0] + law_j[0], law_i[1] + law_j[1], regular[2],
-                                     regular[3], material, before, twist, dt, xj);
-    *out = PairContact{c.force, c.torque, c.kept, c.twist, c.energy, c.dissipated};
+                                     regular[3], material, before, twist, dt,
+                                     load3(s.position, j));
+    return PairContact{c.force, c.torque, c.kept, c.twist, c.energy, c.dissipated};
+}
+
+// A sphere and a polyhedron at their cap `g` under Hertz–Mindlin, the polyhedron
+// locally flat (engine/cpu/pairs.rs, pair_contact).
+static __device__ PairContact hertz_cap(const PairStates& s, const PairTypes& t, unsigned i,
+                                        unsigned j, const VolumeGeometry& g, Spring before,
+                                        double dt) {
+    unsigned ti = s.body_type[i], tj = s.body_type[j];
+    VolumeMotion m = pair_motion(s, t, i, j, g.point, g.normal, 0.0);
+    const HertzTable& h = t.hertz;
+    double r = t.shape[ti] == NO_SHAPE ? h.radius[ti] : h.radius[tj];
+    const double* row =
+        h.material_pairs + MATERIAL_DOUBLES * (h.material[ti] * h.materials + h.material[tj]);
+    RoundContact c = round_contact(g.depth, g.normal, sub(g.point, load3(s.position, j)),
+                                   m.velocity, m.spin, m.inverse_mass, r, row, before, dt);
+    return PairContact{c.force, c.torque, c.kept, 0.0, c.energy, c.dissipated};
+}
+
+// The contact of particles i and j, where they touch (engine/cpu/pairs.rs,
+// pair_contact): two polyhedra under the volume law; a sphere under the volume law
+// where `round_volume`, else under Hertz–Mindlin (against a sphere by
+// contact.cuh's sphere_pair).
+static __device__ bool pair_contact(const ShapeTable& table, const PairStates& s,
+                                    const PairTypes& t, bool round_volume, unsigned i,
+                                    unsigned j, Spring before, double twist, double dt,
+                                    PairContact* out) {
+    unsigned ti = s.body_type[i], tj = s.body_type[j];
+    bool sphere_i = t.shape[ti] == NO_SHAPE, sphere_j = t.shape[tj] == NO_SHAPE;
+    VolumeGeometry g;
+    if (sphere_i && sphere_j && !round_volume) {
+        RoundContact c;
+        if (!sphere_pair(t.hertz, ti, tj, load3(s.position, i), load3(s.position, j),
+                         load3(s.velocity, i), load3(s.velocity, j),
+                         load3(s.angular_momentum, i), load3(s.angular_momentum, j), before, dt,
+                         &c)) {
+            return false;
+        }
+        *out = PairContact{c.force, c.torque, c.kept, 0.0, c.energy, c.dissipated};
+        return true;
+    }
+    if (sphere_i && sphere_j) {
+        if (!lens_geometry(s, t, i, j, &g)) {
+            return false;
+        }
+    } else if (sphere_i || sphere_j) {
+        if (!cap_geometry(table, s, t, i, j, &g)) {
+            return false;
+        }
+        if (!round_volume) {
+            *out = hertz_cap(s, t, i, j, g, before, dt);
+            return true;
+        }
+    } else if (!overlap_geometry(table, s, t, i, j, &g)) {
+        return false;
+    }
+    *out = volume_pair(s, t, i, j, g, before, twist, dt);
     return true;
 }
 
-// One thread per candidate pair of a world of polyhedra, spheres among them or
-// not: where one of the two moves here (is neither frozen nor a ghost), two
-// polyhedra under the volume law (volume_pair), two spheres (contact.cuh,
-// sphere_pair) and a sphere and a polyhedron (cap_pair) under Hertz–Mindlin, into
-// the pair's result, its history replaced by what the contact leaves; apart, a zero
-// result and history, and the friction spring's energy as dissipated
-// (engine/cpu/pairs.rs). The result, energy terms and byte are spheres.cu's (the
-// gather and the sums read both alike); the history is VOLUME_HISTORY_DOUBLES,
-// whatever the pair. Per body type: its shape (NO_SHAPE: a sphere), mass,
-// principal moments, whether they are equal, its volume-law row and material; per
-// pair of materials (row-major) its volume-law row; and the spheres' Hertz–Mindlin
-// table (contact.cuh, HertzTable).
+// One thread per candidate pair of a world with polyhedra or under the volume law:
+// where one of the two moves here (is neither frozen nor a ghost), its contact
+// (pair_contact) into the pair's result, its history replaced by what the contact
+// leaves; apart, a zero result and history, and the friction spring's energy as
+// dissipated (engine/cpu/pairs.rs). The result, energy terms and byte are
+// spheres.cu's (the gather and the sums read both alike); the history is
+// VOLUME_HISTORY_DOUBLES, whatever the pair. Per body type: its shape (NO_SHAPE: a
+// sphere), mass, principal moments, whether they are equal, its volume-law row and
+// material; per pair of materials (row-major) its volume-law row; and the spheres'
+// Hertz–Mindlin table (contact.cuh, HertzTable). Spheres follow the volume law
+// where `round_volume` is 1, Hertz–Mindlin where 0.
 extern "C" __global__ void polyhedron_contacts(
     unsigned pair_count, double dt, const unsigned* pairs, const double* position,
     const double* orientation, const double* velocity, const double* angular_momentum,
@@ -184,15 +267,16 @@ extern "C" __global__ void polyhedron_contacts(
     const unsigned* loops, const Mask* face_masks, const double* vertices, const double* planes,
     const double* circumradius, const double* type_radius, const double* type_inverse_mass,
     const double* type_inverse_inertia, const unsigned* hertz_material, unsigned hertz_materials,
-    const double* material_pairs, double* history, double* results, double* energies,
-    unsigned char* touching) {
+    const double* material_pairs, unsigned round_volume, double* history, double* results,
+    double* energies, unsigned char* touching) {
     unsigned e = blockIdx.x * blockDim.x + threadIdx.x;
     if (e >= pair_count) {
         return;
     }
     ShapeTable table =
         ShapeTable{shape_index, face_span, loops, face_masks, vertices, planes, circumradius};
-    PairStates states = PairStates{position, orientation, velocity, angular_momentum, body_type};
+    PairStates states =
+        PairStates{position, orientation, velocity, angular_momentum, body_type};
     PairTypes types = PairTypes{
         type_mass,   type_inertia,  type_isotropic,
         type_law,    type_material, materials,
@@ -207,24 +291,9 @@ extern "C" __global__ void polyhedron_contacts(
     unsigned char counted_flag = counted ? PAIR_COUNTED : 0u;
     Spring before = Spring{load3(h, 0), h[3]};
     PairContact c;
-    bool touches = false;
-    if (!(role[i] && role[j])) {
-        unsigned ti = body_type[i], tj = body_type[j];
-        bool sphere_i = type_shape[ti] == NO_SHAPE, sphere_j = type_shape[tj] == NO_SHAPE;
-        if (sphere_i && sphere_j) {
-            RoundContact round;
-            touches = sphere_pair(types.hertz, ti, tj, load3(position, i), load3(position, j),
-                                  load3(velocity, i), load3(velocity, j),
-                                  load3(angular_momentum, i), load3(angular_momentum, j), before,
-                                  dt, &round);
-            c = PairContact{round.force, round.torque, round.kept, 0.0, round.energy,
-                            round.dissipated};
-        } else if (sphere_i || sphere_j) {
-            touches = cap_pair(table, states, types, i, j, before, dt, &c);
-        } else {
-            touches = volume_pair(table, states, types, i, j, before, h[4], dt, &c);
-        }
-    }
+    bool touches = !(role[i] && role[j]) &&
+                   pair_contact(table, states, types, round_volume != 0, i, j, before, h[4], dt,
+                                &c);
     if (!touches) {
         for (unsigned k = 0; k < RESULT_DOUBLES; ++k) {
             result[k] = 0.0;

@@ -1,7 +1,8 @@
-// The Hertz–Mindlin contacts of spheres with wall facets (engine/cpu/walls.rs,
-// engine/cpu/patch.rs, geometry/sphere.rs): one thread per particle, every wall's
-// facets tested (no facet list yet: O(particles × facets)), the facets of one
-// plane merged into one contact at the deepest, the contacts added to the
+// The contacts of spheres with wall facets, under Hertz–Mindlin or the volume law
+// (engine/cpu/walls.rs, engine/cpu/patch.rs, geometry/sphere.rs): one thread per
+// particle, every wall's facets tested (no facet list yet: O(particles × facets)),
+// the facets of one plane merged into one contact at the deepest, the contacts
+// added to the
 // particle's force and torque in wall and patch order after the pairs' gather:
 // the CPU backend's operations in its order, so the same bits. Then the walls'
 // forces, torques and facet forces, and the contacts' energies, as rows and
@@ -39,29 +40,30 @@ static __device__ __forceinline__ bool sphere_facet(const double* t, Vec3 centre
         normal = normalize(cross(sub(b, a), sub(c, a)));
     }
     double depth = r - distance;
-    const double pi = 3.14159265358979323846;
-    double hv = fmin(fmax(depth, 0.0), 2.0 * r);
-    double ha = fmin(fmax(depth, 0.0), r);
     out->depth = depth;
     out->normal = normal;
     out->point = sub(q, scale(normal, 0.5 * depth));
-    out->volume = pi * hv * hv * (3.0 * r - hv) / 3.0;
-    out->area = pi * (2.0 * r * ha - ha * ha);
+    out->volume = cap_volume(r, depth);
+    out->area = cap_area(r, depth);
     return true;
 }
 
 // One thread per sphere: its wall contacts (see the file's head), none for a
 // passive one (frozen or a ghost); a particle of a type that is no sphere
 // (`type_sphere` 0) is left alone, its slots and load untouched (a world of
-// polyhedra and spheres: polyhedra.cu writes those). A slot's history is
-// `history_doubles` long (4, or 5 beside the volume law's, the twist 0).
+// polyhedra and spheres: polyhedra.cu writes those). Where `round_volume` is 1 the
+// contact follows the volume law (volume_law.cuh, engine/cpu/walls.rs patch_force:
+// per body type its law row, per pair of materials the volume law's), where 0
+// Hertz–Mindlin. A slot's history is `history_doubles` long (4, or 5: the twist,
+// 0 under Hertz–Mindlin).
 // `overflow` is set when a particle has more than WALL_SLOTS contacts.
 extern "C" __global__ void sphere_walls(
     unsigned n, double dt, const double* position, const double* velocity,
     const double* orientation, const double* angular_momentum, const unsigned* body_type,
     const unsigned char* role, const unsigned char* type_sphere, const double* type_radius,
     const double* type_mass, const double* type_inertia, const unsigned* type_material,
-    unsigned materials, const double* material_pairs, unsigned walls, const unsigned* wall_facets,
+    unsigned materials, const double* material_pairs, unsigned round_volume,
+    const double* type_law, const double* material_law, unsigned walls, const unsigned* wall_facets,
     const double* facets, const double* facet_normals, const unsigned* wall_material,
     const double* wall_motion, unsigned history_doubles, const unsigned* old_count,
     const long long* old_keys, const double* old_springs, unsigned* count, long long* keys,
@@ -157,18 +159,45 @@ extern "C" __global__ void sphere_walls(
                 key[1 + c] = patch_key[p][c];
             }
             Spring before = Spring{Vec3{0.0, 0.0, 0.0}, 0.0};
+            double twist = 0.0;
             unsigned held = held_slot(old_keys + KEY_WORDS * WALL_SLOTS * i, old_count[i], key);
             if (held < old_count[i]) {
                 const double* h = old_springs + history_doubles * (WALL_SLOTS * i + held);
                 before = Spring{load3(h, 0), h[3]};
+                twist = history_doubles > HISTORY_DOUBLES ? h[4] : 0.0;
             }
-            RoundContact c = round_contact(g.depth, g.normal, lever, relative,
-                                           sub(spin, wall_spin), inverse_mass, r, m, before, dt);
+            RoundContact c;
+            if (round_volume) {
+                VolumeGeometry vg;
+                vg.volume = g.volume;
+                vg.area = g.area;
+                vg.depth = g.depth;
+                vg.normal = g.normal;
+                vg.point = g.point;
+                vg.has_gradient = false;
+                const double* law = type_law + TYPE_LAW_DOUBLES * kind;
+                const double* row = material_law + MATERIAL_LAW_DOUBLES *
+                                                       (type_material[kind] * materials +
+                                                        wall_material[w]);
+                VolumeMotion motion =
+                    VolumeMotion{relative, sub(spin, wall_spin), inverse_mass, law[6]};
+                // ContactLaws::wall: the moduli in series over the particle's radius.
+                VolumeContact v =
+                    volume_contact(vg, motion, row[2 + DAMPING_NODES] / law[5],
+                                   row[3 + DAMPING_NODES] / law[5], law[2], law[3], row, before,
+                                   twist, dt, x);
+                c = RoundContact{v.force, v.torque, v.kept, v.energy, v.dissipated};
+                twist = v.twist;
+            } else {
+                c = round_contact(g.depth, g.normal, lever, relative, sub(spin, wall_spin),
+                                  inverse_mass, r, m, before, dt);
+                twist = 0.0;
+            }
             double* h = springs + history_doubles * (WALL_SLOTS * i + made);
             store3(h, 0, c.kept.spring);
             h[3] = c.kept.stiffness;
-            for (unsigned k = HISTORY_DOUBLES; k < history_doubles; ++k) {
-                h[k] = 0.0;
+            if (history_doubles > HISTORY_DOUBLES) {
+                h[4] = twist;
             }
             double* record = records + WALL_RECORD_DOUBLES * (WALL_SLOTS * i + made);
             store3(record, 0, c.force);

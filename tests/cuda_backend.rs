@@ -157,13 +157,22 @@ fn a_scene_asking_for_the_cuda_backend_is_checked_when_read() {
             )
         ),
     }
+    // Spheres under the volume law are stepped; rolling resistance is refused.
     let volume = cuda.replace("law = \"hertz_mindlin\"", "law = \"volume\"");
-    let e = Scene::parse(&volume, Path::new("pour.toml")).unwrap_err();
+    match Scene::parse(&volume, Path::new("pour.toml")) {
+        Ok(_) => assert!(talus::engine::cuda::driver::CudaDevice::is_present()),
+        Err(e) => assert!(e.to_string().contains("no CUDA driver"), "{e}"),
+    }
+    let rolling = cuda.replace(
+        "law = \"hertz_mindlin\"",
+        "law = \"hertz_mindlin\"\nrolling = \"elastic_plastic\"",
+    );
+    let e = Scene::parse(&rolling, Path::new("pour.toml")).unwrap_err();
     assert_eq!(
         e.to_string(),
         format!(
-            "pour.toml:{line}: simulation.backend: the cuda backend does not yet step spheres \
-             under a law other than Hertz–Mindlin without rolling resistance"
+            "pour.toml:{line}: simulation.backend: the cuda backend does not yet step rolling \
+             resistance"
         )
     );
     // Polyhedra are stepped (under the volume law), and so are spheres and

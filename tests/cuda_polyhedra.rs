@@ -459,6 +459,18 @@ fn spheres_and_polyhedra(device: Box<dyn Device>) {
     run.within(1e-8);
 }
 
+/// The beads and dodecahedra under the volume law alone (the scenes' default):
+/// the beads' lenses and caps under the law of the polyhedra.
+#[test]
+fn spheres_and_polyhedra_under_the_volume_law_run_as_on_the_cpu_backend_to_round_off() {
+    let text = MIXED.replace("law = \"hertz_mindlin\"", "law = \"volume\"");
+    let scene = Scene::parse(&text, Path::new("mixed_pour.toml")).unwrap();
+    let run = drift(Box::new(HostDevice::new(64)), &scene, 2000, 0.005);
+    assert!(run.most.0 > 40 && run.most.1 > 20, "{:?}", run.most);
+    assert!(run.kinds.iter().all(|&k| k > 8), "{:?}", run.kinds);
+    run.within(1e-8);
+}
+
 /// Dodecahedra and cubes in a quasi-2D drum turning at 3 rad/s, its end plates
 /// attached to the shell (walls whose facets are placed anew every step): 3400
 /// steps as the bed falls onto the shell and gathers. (Soon after, the bed's

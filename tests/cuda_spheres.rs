@@ -312,6 +312,38 @@ fn thrown_into_a_box(device: Box<dyn Device>) {
     );
 }
 
+/// The clouds under the volume law (the scenes' default): lens and cap volumes,
+/// the volume law's normal force, friction, rocking damping and twist of pairs
+/// and wall contacts, the CPU backend's bits; converging (1000 steps), and thrown
+/// into the box (1000 steps).
+#[test]
+fn clouds_under_the_volume_law_step_as_the_cpu_backend_to_the_bit() {
+    let volume = |(world, mut params): (World, StepParams)| {
+        params.round_law = talus::engine::RoundLaw::Volume;
+        (world, params)
+    };
+    let (start, params) = volume(cloud());
+    let run = parity(host(64), &start, &params, 1000, false);
+    eprintln!("converging: {} contacts at most", run.most_contacts);
+    assert!(
+        run.most_contacts > 500,
+        "{} contacts at most",
+        run.most_contacts
+    );
+    let (start, params) = volume(cloud_in(OPEN_BOX, 30.0));
+    let run = parity(host(64), &start, &params, 1000, false);
+    eprintln!(
+        "thrown: {} wall contacts, {} contacts at most",
+        run.most_wall_contacts, run.most_contacts
+    );
+    assert!(
+        run.most_wall_contacts > 40 && run.most_contacts > 60,
+        "{} wall contacts, {} contacts at most",
+        run.most_wall_contacts,
+        run.most_contacts
+    );
+}
+
 /// A drum turning at 3 rad/s about a horizontal axis, its end plates attached to
 /// the shell (walls that move, their facets placed anew every step), with 53 beads
 /// falling onto the shell and carried up: 5000 steps.
@@ -483,13 +515,14 @@ fn share_with_ghosts(device: Box<dyn Device>, spread: f64) -> Parity {
 #[test]
 fn other_laws_are_refused() {
     let (world, params) = cloud();
-    let mut volume = params;
-    volume.round_law = talus::engine::RoundLaw::Volume;
+    let mut rolling = params;
+    rolling.round_law = talus::engine::RoundLaw::HertzMindlin {
+        rolling: talus::contact::RollingModel::ConstantTorque,
+    };
     let said = |r: Result<DeviceWorld, StepperError>| r.unwrap_err().to_string();
     assert_eq!(
-        said(DeviceWorld::new(host(64), &world, &volume)),
-        "the cuda backend does not yet step spheres under a law other than Hertz–Mindlin without \
-         rolling resistance"
+        said(DeviceWorld::new(host(64), &world, &rolling)),
+        "the cuda backend does not yet step rolling resistance"
     );
 }
 

@@ -29,8 +29,10 @@ use crate::world::World;
 pub(super) const NO_SHAPE: u32 = u32::MAX;
 /// Doubles of a body type's law row (`TYPE_LAW_DOUBLES` of volume_law.cuh).
 const TYPE_LAW: usize = 7;
+/// Nodes of a damping table (`DAMPING_NODES`).
+const DAMPING_NODES: usize = 21;
 /// Doubles of a pair of materials' law row (`MATERIAL_LAW_DOUBLES`).
-const MATERIAL_LAW: usize = 25;
+const MATERIAL_LAW: usize = 4 + DAMPING_NODES;
 /// Doubles of a contact's history (`VOLUME_HISTORY_DOUBLES`).
 pub(super) const HISTORY: usize = 5;
 /// Doubles of a pair's result and energy terms (`RESULT_DOUBLES` and
@@ -40,8 +42,8 @@ const PAIR_ENERGY: usize = 2;
 /// A pair's byte where it touches (`PAIR_TOUCHES`).
 const PAIR_TOUCHES: u8 = 1;
 
-/// The body types of a world of polyhedra (spheres among them or not) and its
-/// pairs of materials on a device.
+/// The body types of a world (polyhedra, spheres or both) and its pairs of
+/// materials on a device, as the contact kernels read them.
 ///
 /// # Invariant
 /// Every polyhedron's shape is in `shapes` at `shape[t]`, a sphere's `shape[t]` is
@@ -54,17 +56,21 @@ pub struct DeviceBodyTypes {
     pub(super) shape: Array<u32>,
     /// The spheres' Hertz–Mindlin table.
     pub(super) hertz: HertzTypes,
+    /// Whether a body type is a polyhedron.
+    pub(super) polyhedra: bool,
+    /// Whether spheres follow the volume law (else Hertz–Mindlin).
+    pub(super) round_volume: bool,
     mass: Array<Real>,
     /// Principal moments, three per type.
     inertia: Array<Real>,
     /// 1 where the three moments are equal (`is_isotropic`).
     isotropic: Array<u8>,
     /// The law rows (`TYPE_LAW_DOUBLES` of volume_law.cuh).
-    law: Array<Real>,
+    pub(super) law: Array<Real>,
     material: Array<u32>,
     material_count: u32,
     /// Per pair of materials, row-major (`MATERIAL_LAW_DOUBLES`).
-    material_law: Array<Real>,
+    pub(super) material_law: Array<Real>,
 }
 
 impl DeviceBodyTypes {
@@ -102,9 +108,10 @@ impl DeviceBodyTypes {
         device: &mut dyn Device,
         world: &World,
         regularisation_length: Real,
+        round: RoundLaw,
     ) -> Result<Self, ShapeTableError> {
         let mut laws = ContactLaws::default();
-        laws.prepare(world, regularisation_length, RoundLaw::Volume);
+        laws.prepare(world, regularisation_length, round);
         let mut distinct: Vec<&ConvexPolyhedron> = Vec::new();
         let mut index_of: HashMap<*const ConvexPolyhedron, u32> = HashMap::new();
         let mut shape = Vec::new();
@@ -136,9 +143,12 @@ impl DeviceBodyTypes {
         }
         let mut material_law = Vec::new();
         for (friction, table, wall_series) in laws.material_rows() {
-            let table = table.expect("the volume law's damping tables, prepared for polyhedra");
-            material_law.extend([friction, table.restitution()]);
-            material_law.extend(table.nodes());
+            // No table where no contact follows the volume law (spheres under
+            // Hertz–Mindlin): a row of zeros, never read.
+            let none = [0.0; DAMPING_NODES];
+            let (restitution, nodes) = table.map_or((0.0, &none), |t| (t.restitution(), t.nodes()));
+            material_law.extend([friction, restitution]);
+            material_law.extend(nodes);
             material_law.extend([wall_series.normal, wall_series.tangential]);
         }
         debug_assert_eq!(
@@ -146,6 +156,8 @@ impl DeviceBodyTypes {
             MATERIAL_LAW * laws.material_count().pow(2)
         );
         let mut uploaded = DeviceBodyTypes {
+            polyhedra: !distinct.is_empty(),
+            round_volume: round == RoundLaw::Volume,
             shapes: DeviceShapes::upload(device, &distinct)?,
             hertz: HertzTypes::upload(device, world)?,
             material_count: laws.material_count() as u32,
@@ -225,6 +237,7 @@ pub(super) unsafe fn polyhedron_contacts(
     args.extend(types.shapes.args());
     args.extend(types.hertz.args());
     args.extend([
+        Arg::U32(u32::from(types.round_volume)),
         out.history.arg(),
         out.results.arg(),
         out.energies.arg(),

@@ -13,11 +13,10 @@ use nalgebra::Vector3;
 
 use super::Kernel;
 use super::device::{Arg, Array, Device, DeviceError};
-use super::device_hertz::HertzTypes;
 use super::device_list::run;
 use super::device_states::StateView;
 use super::device_sums::{RowSums, first_rows};
-use super::device_volume_contacts::{DeviceBodyTypes, HISTORY as VOLUME_HISTORY};
+use super::device_volume_contacts::DeviceBodyTypes;
 use super::device_wall_patches::{
     DeviceWallPatches, Loads, PolyhedronSums, polyhedron_wall_contacts, polyhedron_wall_sum_rows,
 };
@@ -29,9 +28,6 @@ use crate::contact::TangentialHistory;
 use crate::engine::backend::WallKey;
 use crate::engine::cpu::motion::advance_walls;
 use crate::world::World;
-
-/// Doubles of a Hertz–Mindlin contact's friction spring.
-const SPRING: usize = 4;
 
 /// Doubles the rows of the walls' first pass may take together (32 MiB): a row for
 /// every 8 particles where that fits, fewer for walls of many facets (each row
@@ -50,10 +46,8 @@ pub(super) struct WallInputs<'a> {
     /// Per body type its mass and principal moments.
     pub type_mass: &'a Array<Real>,
     pub type_inertia: &'a Array<Real>,
-    /// The spheres' law (and every type's bounding radius).
-    pub hertz: &'a HertzTypes,
-    /// The polyhedra's law and shapes, where the world has polyhedra.
-    pub volume: Option<&'a DeviceBodyTypes>,
+    /// The contact laws' rows and the shapes.
+    pub laws: &'a DeviceBodyTypes,
     pub loads: Loads<'a>,
 }
 
@@ -74,9 +68,15 @@ pub(super) struct DeviceWalls {
 }
 
 impl DeviceWalls {
-    /// The walls of `world`, placed and uploaded, for `n` particles: spheres
-    /// under Hertz–Mindlin, polyhedra under the volume law.
-    pub fn new(device: &mut dyn Device, world: &World, n: usize) -> Result<Self, DeviceError> {
+    /// The walls of `world`, placed and uploaded, for `n` particles whose contacts
+    /// keep histories of `width` doubles (4 where every particle is a sphere under
+    /// Hertz–Mindlin, else 5: the twist).
+    pub fn new(
+        device: &mut dyn Device,
+        world: &World,
+        n: usize,
+        width: usize,
+    ) -> Result<Self, DeviceError> {
         let shapes = || world.body_types.iter().map(|t| &t.shape);
         let spheres = shapes().any(|s| s.as_sphere().is_some());
         let polyhedra = shapes().any(|s| s.as_polyhedron().is_some());
@@ -86,7 +86,6 @@ impl DeviceWalls {
         // Without walls the per-particle slots hold nothing (the energy sum still
         // takes them as arguments).
         let n = if host.walls.is_empty() { 0 } else { n };
-        let width = if polyhedra { VOLUME_HISTORY } else { SPRING };
         Ok(DeviceWalls {
             placed: PlacedWalls::new(device, &host.walls)?,
             slots: WallSlots::new(device, n, width)?,
@@ -153,7 +152,8 @@ impl DeviceWalls {
         // Each particle's contacts come from one kernel: a polyhedron's from the
         // patches', a sphere's from sphere_walls, after (polyhedron_wall_contacts
         // leaves a sphere no contact).
-        if let (Some(types), Some(patches)) = (at.volume, &mut self.patches) {
+        if let Some(patches) = &mut self.patches {
+            let types = at.laws;
             // SAFETY: the patches' arrays sized for the states' particles.
             unsafe { patches.launch_find(device, types, &at.states, walls, readback.flag())? };
             let (states, slots) = (&at.states, &self.slots);
@@ -166,8 +166,9 @@ impl DeviceWalls {
         }
         let partials = self.sums.rows(device, rows, width)?;
         let (new, slots) = (&self.slots.new, &self.slots);
-        match (at.volume, &self.patches) {
-            (Some(types), Some(patches)) => {
+        match &self.patches {
+            Some(patches) => {
+                let types = at.laws;
                 // SAFETY: `partials` has room for `rows` rows of the walls' width;
                 // the patches and slots hold the particles' of `at`.
                 unsafe {
@@ -181,7 +182,7 @@ impl DeviceWalls {
                     polyhedron_wall_sum_rows(device, &sums, rows, partials)?;
                 }
             }
-            _ => {
+            None => {
                 // SAFETY: the parameters of wall_sum_rows (walls.cu): the slots hold n
                 // particles', `partials` room for `rows` rows of `width`.
                 unsafe {
@@ -210,15 +211,16 @@ impl DeviceWalls {
             .fold(device, rows, width, &readback.device, readback::WALLS)
     }
 
-    /// The Hertz–Mindlin contacts of spheres with the walls (`sphere_walls` of
-    /// walls.cu), the readback's flag set where a sphere has too many.
+    /// The contacts of spheres with the walls (`sphere_walls` of walls.cu, under
+    /// Hertz–Mindlin or the volume law), the readback's flag set where a sphere
+    /// has too many.
     fn sphere_contacts(
         &self,
         device: &mut dyn Device,
         at: &WallInputs,
         readback: &Readback,
     ) -> Result<(), DeviceError> {
-        let (s, w, h) = (&at.states, &self.placed, at.hertz);
+        let (s, w, h) = (&at.states, &self.placed, &at.laws.hertz);
         let mut args = vec![
             Arg::U32(s.len() as u32),
             Arg::F64(at.dt),
@@ -235,6 +237,9 @@ impl DeviceWalls {
             h.material.arg(),
             Arg::U32(h.materials),
             h.material_pairs.arg(),
+            Arg::U32(u32::from(at.laws.round_volume)),
+            at.laws.law.arg(),
+            at.laws.material_law.arg(),
             w.count_arg(),
             w.wall_facets.arg(),
             w.facets.arg(),

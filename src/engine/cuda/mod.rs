@@ -66,10 +66,10 @@ pub static OVERLAP: KernelFile = KernelFile {
     headers: &[],
 };
 
-/// The contact of a sphere with a convex polyhedron.
-pub static SPHERE_POLYHEDRON: KernelFile = KernelFile {
-    name: "sphere_polyhedron.cuh",
-    source: include_str!("../../../kernels/sphere_polyhedron.cuh"),
+/// The geometry of a sphere's contacts: with a sphere, with a convex polyhedron.
+pub static ROUND_GEOMETRY: KernelFile = KernelFile {
+    name: "round_geometry.cuh",
+    source: include_str!("../../../kernels/round_geometry.cuh"),
     headers: &[],
 };
 
@@ -133,7 +133,7 @@ pub static FILES: [KernelFile; 9] = [
     KernelFile {
         name: "walls.cu",
         source: include_str!("../../../kernels/walls.cu"),
-        headers: &[&VEC, &CONTACT, &BODY, &TRIANGLE],
+        headers: &[&VEC, &CONTACT, &BODY, &TRIANGLE, &VOLUME_LAW],
     },
     KernelFile {
         name: "sums.cu",
@@ -159,7 +159,7 @@ pub static FILES: [KernelFile; 9] = [
             &BODY,
             &TRIANGLE,
             &OVERLAP,
-            &SPHERE_POLYHEDRON,
+            &ROUND_GEOMETRY,
             &VOLUME_LAW,
             &FACET,
             &WALL_PATCHES,

@@ -124,7 +124,9 @@ fn volume_contacts_equal_the_cpu_pair_stage() {
     laws.prepare(&world, REGULARISATION_LENGTH, RoundLaw::Volume);
     let dt = 2e-6;
     let mut device = HostDevice::new(64);
-    let types = DeviceBodyTypes::upload(&mut device, &world, REGULARISATION_LENGTH).unwrap();
+    let types =
+        DeviceBodyTypes::upload(&mut device, &world, REGULARISATION_LENGTH, RoundLaw::Volume)
+            .unwrap();
     let mut states = DeviceStates::default();
     states.upload(&mut device, &world.particles).unwrap();
     let list: Vec<(u32, u32)> = (0..pairs as u32).map(|k| (2 * k, 2 * k + 1)).collect();
@@ -272,7 +274,9 @@ struct OnDevice {
 
 fn on_device(world: &World) -> OnDevice {
     let mut device = HostDevice::new(64);
-    let types = DeviceBodyTypes::upload(&mut device, world, REGULARISATION_LENGTH).unwrap();
+    let types =
+        DeviceBodyTypes::upload(&mut device, world, REGULARISATION_LENGTH, RoundLaw::Volume)
+            .unwrap();
     let mut states = DeviceStates::default();
     states.upload(&mut device, &world.particles).unwrap();
     let walls = PlacedWalls::new(&mut device, &world.walls).unwrap();

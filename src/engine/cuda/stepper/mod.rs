@@ -38,7 +38,6 @@ mod transfer;
 
 use super::Kernel;
 use super::device::{Arg, Array, Device, DeviceError};
-use super::device_hertz::HertzTypes;
 use super::device_list::{DeviceList, ListInputs, run};
 use super::device_polyhedra::{MAX_SHAPE_PARTS, ShapeTableError};
 use super::device_states::{StateView, roles};
@@ -77,47 +76,29 @@ pub enum StepperError {
 }
 
 /// Per body type, what integration reads (mass, principal moments), and the
-/// contact laws' rows.
+/// contact laws' rows and shapes.
 #[derive(Debug)]
 struct TypeArrays {
     mass: Array<Real>,
     inertia: Array<Real>,
-    law: PairLaw,
+    laws: Box<DeviceBodyTypes>,
 }
 
-/// The contact laws of a world's pairs and wall contacts, with what they read per
-/// body type and pair of materials.
-#[derive(Debug)]
-enum PairLaw {
-    /// Spheres under Hertz–Mindlin.
-    Hertz(HertzTypes),
-    /// Polyhedra under the volume law with their shapes, and spheres among them
-    /// under Hertz–Mindlin.
-    Volume(Box<DeviceBodyTypes>),
-}
-
-impl PairLaw {
-    /// The Hertz–Mindlin table: the spheres' law, and every type's bounding radius.
-    fn hertz(&self) -> &HertzTypes {
-        match self {
-            PairLaw::Hertz(h) => h,
-            PairLaw::Volume(types) => &types.hertz,
-        }
+impl TypeArrays {
+    /// Whether every pair is two spheres under Hertz–Mindlin (`sphere_contacts`,
+    /// four doubles of history), else any pair of the world (`polyhedron_contacts`,
+    /// five doubles).
+    fn spheres_under_hertz(&self) -> bool {
+        !self.laws.polyhedra && !self.laws.round_volume
     }
 
-    /// The volume law's rows and shapes, where the world has polyhedra.
-    fn volume(&self) -> Option<&DeviceBodyTypes> {
-        match self {
-            PairLaw::Hertz(_) => None,
-            PairLaw::Volume(types) => Some(types),
-        }
-    }
-
-    /// Bytes of device memory held.
-    fn bytes(&self, d: &dyn Device) -> usize {
-        match self {
-            PairLaw::Hertz(h) => h.bytes(d),
-            PairLaw::Volume(types) => types.bytes(d),
+    /// Doubles of a contact's tangential history: the spring and its stiffness,
+    /// and but for spheres under Hertz–Mindlin alone the twist.
+    fn history_width(&self) -> usize {
+        if self.spheres_under_hertz() {
+            HISTORY
+        } else {
+            VOLUME_HISTORY
         }
     }
 }
@@ -235,19 +216,16 @@ impl DeviceWorld {
             .collect();
         let d = device.as_mut();
         let bodies = &world.body_types;
-        let law = if bodies.iter().any(|t| t.shape.as_polyhedron().is_some()) {
-            let types = DeviceBodyTypes::upload(d, world, params.regularisation_length);
-            PairLaw::Volume(Box::new(types.map_err(|e| match e {
-                ShapeTableError::Device(e) => StepperError::Device(e),
-                other => StepperError::Unsupported(other.to_string()),
-            })?))
-        } else {
-            PairLaw::Hertz(HertzTypes::upload(d, world)?)
-        };
+        let laws =
+            DeviceBodyTypes::upload(d, world, params.regularisation_length, params.round_law)
+                .map_err(|e| match e {
+                    ShapeTableError::Device(e) => StepperError::Device(e),
+                    other => StepperError::Unsupported(other.to_string()),
+                })?;
         let mut types = TypeArrays {
             mass: Array::default(),
             inertia: Array::default(),
-            law,
+            laws: Box::new(laws),
         };
         types
             .mass
@@ -262,7 +240,7 @@ impl DeviceWorld {
         let skin = if skin.is_finite() { skin.max(0.0) } else { 0.0 };
         let largest = radii.iter().copied().fold(0.0, Real::max);
         let list = DeviceList::new(skin, 2.0 * largest + skin);
-        let walls = DeviceWalls::new(d, world, p.len())?;
+        let walls = DeviceWalls::new(d, world, p.len(), types.history_width())?;
         let readback = Readback::new(d, walls.sums_width())?;
         let order = id_order(p);
         let mut stepper = DeviceWorld {
@@ -308,14 +286,9 @@ impl DeviceWorld {
             }
         }
         let spheres = (world.body_types.iter()).any(|t| t.shape.as_sphere().is_some());
-        // Polyhedra step under the volume law whatever the spheres' law.
-        let hertz = RoundLaw::HertzMindlin {
-            rolling: RollingModel::None,
-        };
-        if spheres && params.round_law != hertz {
-            return unsupported(
-                "spheres under a law other than Hertz–Mindlin without rolling resistance",
-            );
+        let rolling = matches!(params.round_law, RoundLaw::HertzMindlin { rolling } if rolling != RollingModel::None);
+        if spheres && rolling {
+            return unsupported("rolling resistance");
         }
         Ok(())
     }
@@ -474,7 +447,7 @@ impl DeviceWorld {
                 body_type: &p.body_type,
                 id: &p.id,
                 cell_code: &p.cell_code,
-                type_radius: &t.law.hertz().radius,
+                type_radius: &t.laws.hertz.radius,
             };
             // The tangential history carried over by the pairs' ids: from this list,
             // or from a history set from outside.
@@ -509,40 +482,37 @@ impl DeviceWorld {
         }
         let count = list.pair_count;
         let states = p.view();
-        match &t.law {
-            PairLaw::Hertz(h) => {
-                let mut args = vec![
-                    Arg::U32(count as u32),
-                    Arg::F64(dt),
-                    list.pairs.arg(),
-                    p.position.arg(),
-                    p.velocity.arg(),
-                    p.angular_momentum.arg(),
-                    p.body_type.arg(),
-                    p.role.arg(),
-                ];
-                args.extend(h.args());
-                args.extend([
-                    pairs.history.arg(),
-                    pairs.results.arg(),
-                    pairs.terms.arg(),
-                    pairs.touching.arg(),
-                ]);
-                // SAFETY: the parameters of sphere_contacts (spheres.cu), every array
-                // sized for its pairs, particles or body types.
-                unsafe { run(d, Kernel::SphereContacts, count, &args)? };
-            }
-            PairLaw::Volume(types) => {
-                let out = PairOutputs {
-                    history: &pairs.history,
-                    results: &pairs.results,
-                    energies: &pairs.terms,
-                    touching: &pairs.touching,
-                };
-                // SAFETY: the states hold every particle of the list's pairs, the
-                // types every body type; the outputs sized for `count` pairs.
-                unsafe { polyhedron_contacts(d, types, &states, count, &list.pairs, &out, dt)? };
-            }
+        if t.spheres_under_hertz() {
+            let mut args = vec![
+                Arg::U32(count as u32),
+                Arg::F64(dt),
+                list.pairs.arg(),
+                p.position.arg(),
+                p.velocity.arg(),
+                p.angular_momentum.arg(),
+                p.body_type.arg(),
+                p.role.arg(),
+            ];
+            args.extend(t.laws.hertz.args());
+            args.extend([
+                pairs.history.arg(),
+                pairs.results.arg(),
+                pairs.terms.arg(),
+                pairs.touching.arg(),
+            ]);
+            // SAFETY: the parameters of sphere_contacts (spheres.cu), every array
+            // sized for its pairs, particles or body types.
+            unsafe { run(d, Kernel::SphereContacts, count, &args)? };
+        } else {
+            let out = PairOutputs {
+                history: &pairs.history,
+                results: &pairs.results,
+                energies: &pairs.terms,
+                touching: &pairs.touching,
+            };
+            // SAFETY: the states hold every particle of the list's pairs, the types
+            // every body type; the outputs sized for `count` pairs.
+            unsafe { polyhedron_contacts(d, &t.laws, &states, count, &list.pairs, &out, dt)? };
         }
         let g = self.gravity;
         // SAFETY: the parameters of gather_forces (spheres.cu), every array sized
@@ -576,8 +546,7 @@ impl DeviceWorld {
                 states,
                 type_mass: &t.mass,
                 type_inertia: &t.inertia,
-                hertz: t.law.hertz(),
-                volume: t.law.volume(),
+                laws: &t.laws,
                 loads: Loads {
                     force: &p.force,
                     torque: &p.torque,
@@ -609,10 +578,7 @@ impl DeviceWorld {
     /// Doubles of a pair's tangential history: the spring and its stiffness, and
     /// under the volume law the twist.
     fn history_width(&self) -> usize {
-        match self.types.law {
-            PairLaw::Hertz(_) => HISTORY,
-            PairLaw::Volume(_) => VOLUME_HISTORY,
-        }
+        self.types.history_width()
     }
 }
 

@@ -36,7 +36,7 @@ impl DeviceWorld {
         doubles.iter().map(|a| a.bytes(d)).sum::<usize>()
             + bytes.iter().map(|a| a.bytes(d)).sum::<usize>()
             + p.body_type.bytes(d)
-            + t.law.bytes(d)
+            + t.laws.bytes(d)
             + p.id.bytes(d)
             + p.cell_code.bytes(d)
             + self.list.bytes(d)
