@@ -20,7 +20,14 @@
 #define RESULT_DOUBLES 9u
 // A pair's energy terms (spheres.cu): elastic energy, dissipated.
 #define PAIR_ENERGY_DOUBLES 2u
-#define MATERIAL_DOUBLES 5u
+// A pair of materials' Hertz–Mindlin row: E*, G*, β, √(4G*/E*), the friction
+// coefficient, the rolling friction coefficient and the rolling damping ratio.
+#define MATERIAL_DOUBLES 7u
+// Rolling resistance models (contact/rolling.rs): none, constant torque (model A),
+// elastic–plastic spring–dashpot (model C).
+#define ROLLING_NONE 0u
+#define ROLLING_CONSTANT 1u
+#define ROLLING_ELASTIC_PLASTIC 2u
 
 // Whether this world counts pair (i, j), i of the smaller id, in its totals
 // (world/particles.rs, Particles::counts_pair): where i is owned, unless i is
@@ -96,17 +103,64 @@ struct RoundContact {
     Vec3 force, torque;
     Spring kept;
     double energy, dissipated;
+    // The rolling spring's torque to keep.
+    Vec3 rolling;
 };
+
+// A round contact's rolling resistance: the model, the rolling inertia about the
+// contact point, and the spring's torque of the last step.
+struct Rolling {
+    unsigned model;
+    double inertia;
+    Vec3 spring;
+};
+
+// The rolling torque on body 2 of a contact of unit normal `n` and relative spin
+// `spin` under `r` (contact/rolling.rs, rolling_torque), with the pair's rolling
+// friction and damping, the normal force and stiffness and the effective radius;
+// the spring's torque to keep into *kept.
+static __device__ Vec3 rolling_torque(const Rolling& r, double friction, double damping, Vec3 n,
+                                      Vec3 spin, double normal_force, double normal_stiffness,
+                                      double radius, double dt, Vec3* kept) {
+    Vec3 zero = Vec3{0.0, 0.0, 0.0};
+    Vec3 roll = sub(spin, scale(n, dot(n, spin)));
+    double limit = friction * radius * normal_force;
+    if (r.model == ROLLING_CONSTANT) {
+        *kept = zero;
+        double speed = norm(roll);
+        return speed > 0.0 ? scale(roll, -limit / speed) : zero;
+    }
+    double arm = friction * radius;
+    double kr = 2.25 * normal_stiffness * (arm * arm);
+    // The kept torque, turned into the current tangent plane at its length.
+    Vec3 held = sub(r.spring, scale(n, dot(n, r.spring)));
+    double projected = norm(held);
+    if (projected > 0.0) {
+        held = scale(held, norm(r.spring) / projected);
+    }
+    Vec3 elastic = sub(held, scale(roll, kr * dt));
+    double magnitude = norm(elastic);
+    if (magnitude > limit) {
+        Vec3 capped = scale(elastic, limit / magnitude);
+        *kept = capped;
+        return capped;
+    }
+    Vec3 dashpot = scale(roll, -2.0 * damping * sqrt(r.inertia * kr));
+    Vec3 total = add(elastic, dashpot);
+    double size = norm(total);
+    *kept = elastic;
+    return size > limit ? scale(total, limit / size) : total;
+}
 
 // A Hertz–Mindlin contact of `depth` along `normal` (from body 1 to body 2), at
 // `lever` from body 2's centroid, with the relative velocity at the contact point,
-// the relative spin, the inverse effective mass, the effective radius and the
-// material pair's row `m` (engine/cpu/hertz.rs `round_contact_force`, without
-// rolling resistance).
+// the relative spin, the inverse effective mass, the effective radius, the
+// material pair's row `m` and the rolling resistance `roll` (engine/cpu/hertz.rs
+// `round_contact_force`).
 static __device__ RoundContact round_contact(double depth, Vec3 normal, Vec3 lever,
                                              Vec3 relative, Vec3 spin, double inverse_mass,
                                              double radius, const double* m, Spring before,
-                                             double dt) {
+                                             Rolling roll, double dt) {
     double young = m[0], shear = m[1], beta = m[2], damping_ratio = m[3], friction = m[4];
     // Hertz–Mindlin (contact/hertz_mindlin.rs).
     double mass = 1.0 / inverse_mass;
@@ -124,35 +178,44 @@ static __device__ RoundContact round_contact(double depth, Vec3 normal, Vec3 lev
                               friction * normal_force, &c.kept);
     c.force = add(scale(normal, normal_force), t);
     c.torque = cross(lever, c.force);
+    Vec3 resisting = Vec3{0.0, 0.0, 0.0};
+    c.rolling = roll.spring;
+    if (roll.model != ROLLING_NONE) {
+        resisting = rolling_torque(roll, m[5], m[6], normal, spin, normal_force, stiffness,
+                                   radius, dt, &c.rolling);
+        c.torque = add(c.torque, resisting);
+    }
     c.energy = 0.4 * elastic * depth + spring_energy(c.kept);
     // Energy dissipated over the step (engine/cpu/forces.rs `dissipated`): the work
     // of the force less its elastic normal part at the step's end velocity.
     Vec3 damping = sub(c.force, scale(normal, elastic));
     Vec3 moved = add(relative, scale(c.force, 0.5 * dt * inverse_mass));
-    c.dissipated = -dt * (dot(damping, moved) + dot(Vec3{0.0, 0.0, 0.0}, spin)) -
+    c.dissipated = -dt * (dot(damping, moved) + dot(resisting, spin)) -
                    (spring_energy(c.kept) - spring_energy(before));
     return c;
 }
 
 
 // What the Hertz–Mindlin contacts of spheres read: per body type its radius, 1/m,
-// 1/I and material; per pair of materials (row-major) E*, G*, β, √(4G*/E*) and the
-// friction coefficient (MATERIAL_DOUBLES).
+// 1/I, rolling inertia about a contact on its surface (I + m r²) and material; per
+// pair of materials (row-major) its row (MATERIAL_DOUBLES).
 struct HertzTable {
     const double* radius;
     const double* inverse_mass;
     const double* inverse_inertia;
+    const double* rolling_inertia;
     const unsigned* material;
     unsigned materials;
     const double* material_pairs;
 };
 
 // The contact of spheres of types ti and tj at xi and xj, moving at vi and vj with
-// angular momenta li and lj, holding `before` (engine/cpu/hertz.rs, sphere_pair):
-// false where they do not overlap (or their centres coincide).
+// angular momenta li and lj, holding `before` and the rolling spring `rolling`
+// under rolling model `model` (engine/cpu/hertz.rs, sphere_pair): false where they
+// do not overlap (or their centres coincide).
 static __device__ bool sphere_pair(const HertzTable& t, unsigned ti, unsigned tj, Vec3 xi,
                                    Vec3 xj, Vec3 vi, Vec3 vj, Vec3 li, Vec3 lj, Spring before,
-                                   double dt, RoundContact* c) {
+                                   unsigned model, Vec3 rolling, double dt, RoundContact* c) {
     double ra = t.radius[ti], rb = t.radius[tj];
     Vec3 d = sub(xj, xi);
     double distance_squared = norm_squared(d);
@@ -172,7 +235,10 @@ static __device__ bool sphere_pair(const HertzTable& t, unsigned ti, unsigned tj
     double inverse_mass = t.inverse_mass[ti] + t.inverse_mass[tj];
     const double* m =
         t.material_pairs + MATERIAL_DOUBLES * (t.material[ti] * t.materials + t.material[tj]);
+    double inertia = model == ROLLING_NONE
+                         ? 0.0
+                         : 1.0 / (1.0 / t.rolling_inertia[ti] + 1.0 / t.rolling_inertia[tj]);
     *c = round_contact(depth, normal, lever_j, relative, spin, inverse_mass, ra * rb / (ra + rb),
-                       m, before, dt);
+                       m, before, Rolling{model, inertia, rolling}, dt);
     return true;
 }

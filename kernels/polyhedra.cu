@@ -38,6 +38,9 @@ extern "C" __global__ void polyhedron_overlaps(
 
 // A body type without a shape in the table: a sphere.
 #define NO_SHAPE 0xffffffffu
+// Doubles of a history with a rolling spring: the spring, its stiffness, the
+// twist, the rolling spring.
+#define ROLLING_HISTORY_DOUBLES 8u
 
 // What a pair's contact puts on the second particle (force, torque about its
 // centroid), the first's reaction torque, the energies, and the history it keeps.
@@ -45,6 +48,7 @@ struct PairContact {
     Vec3 force, torque;
     Spring kept;
     double twist, energy, dissipated;
+    Vec3 rolling;
 };
 
 // What the pair kernel reads of the particles.
@@ -171,10 +175,10 @@ static __device__ VolumeMotion pair_motion(const PairStates& s, const PairTypes&
 }
 
 // The volume law's contact `g` of particles i and j, holding `before` and `twist`
-// (engine/cpu/forces.rs, pair_force).
+// (engine/cpu/forces.rs, pair_force); a rolling spring is kept as it was.
 static __device__ PairContact volume_pair(const PairStates& s, const PairTypes& t, unsigned i,
                                           unsigned j, const VolumeGeometry& g, Spring before,
-                                          double twist, double dt) {
+                                          double twist, Vec3 rolling, double dt) {
     unsigned ti = s.body_type[i], tj = s.body_type[j];
     const double* law_i = t.law + TYPE_LAW_DOUBLES * ti;
     const double* law_j = t.law + TYPE_LAW_DOUBLES * tj;
@@ -186,33 +190,46 @@ static __device__ PairContact volume_pair(const PairStates& s, const PairTypes& 
     VolumeContact c = volume_contact(g, m, law_i[0] + law_j[0], law_i[1] + law_j[1], regular[2],
                                      regular[3], material, before, twist, dt,
                                      load3(s.position, j));
-    return PairContact{c.force, c.torque, c.kept, c.twist, c.energy, c.dissipated};
+    return PairContact{c.force, c.torque, c.kept, c.twist, c.energy, c.dissipated, rolling};
+}
+
+// The rolling inertia `I + m r²` of body type `ti` about a contact at `r` from its
+// centroid, I its smallest principal moment (engine/cpu/hertz.rs, rolling_inertia).
+static __device__ __forceinline__ double rolling_inertia(const PairTypes& t, unsigned ti,
+                                                         double r) {
+    Vec3 inertia = load3(t.inertia, ti);
+    return fmin(fmin(inertia.x, inertia.y), inertia.z) + t.mass[ti] * r * r;
 }
 
 // A sphere and a polyhedron at their cap `g` under Hertz–Mindlin, the polyhedron
-// locally flat (engine/cpu/pairs.rs, pair_contact).
+// locally flat, with the rolling resistance `roll` (its inertia found here)
+// (engine/cpu/pairs.rs, pair_contact).
 static __device__ PairContact hertz_cap(const PairStates& s, const PairTypes& t, unsigned i,
                                         unsigned j, const VolumeGeometry& g, Spring before,
-                                        double dt) {
+                                        Rolling roll, double dt) {
     unsigned ti = s.body_type[i], tj = s.body_type[j];
     VolumeMotion m = pair_motion(s, t, i, j, g.point, g.normal, 0.0);
     const HertzTable& h = t.hertz;
     double r = t.shape[ti] == NO_SHAPE ? h.radius[ti] : h.radius[tj];
     const double* row =
         h.material_pairs + MATERIAL_DOUBLES * (h.material[ti] * h.materials + h.material[tj]);
-    RoundContact c = round_contact(g.depth, g.normal, sub(g.point, load3(s.position, j)),
-                                   m.velocity, m.spin, m.inverse_mass, r, row, before, dt);
-    return PairContact{c.force, c.torque, c.kept, 0.0, c.energy, c.dissipated};
+    Vec3 xj = load3(s.position, j);
+    double lever_i = norm(sub(g.point, load3(s.position, i))), lever_j = norm(sub(g.point, xj));
+    roll.inertia =
+        1.0 / (1.0 / rolling_inertia(t, ti, lever_i) + 1.0 / rolling_inertia(t, tj, lever_j));
+    RoundContact c = round_contact(g.depth, g.normal, sub(g.point, xj), m.velocity, m.spin,
+                                   m.inverse_mass, r, row, before, roll, dt);
+    return PairContact{c.force, c.torque, c.kept, 0.0, c.energy, c.dissipated, c.rolling};
 }
 
 // The contact of particles i and j, where they touch (engine/cpu/pairs.rs,
 // pair_contact): two polyhedra under the volume law; a sphere under the volume law
-// where `round_volume`, else under Hertz–Mindlin (against a sphere by
-// contact.cuh's sphere_pair).
+// where `round_volume`, else under Hertz–Mindlin with the rolling resistance
+// `roll` (against a sphere by contact.cuh's sphere_pair).
 static __device__ bool pair_contact(const ShapeTable& table, const PairStates& s,
                                     const PairTypes& t, bool round_volume, unsigned i,
-                                    unsigned j, Spring before, double twist, double dt,
-                                    PairContact* out) {
+                                    unsigned j, Spring before, double twist, Rolling roll,
+                                    double dt, PairContact* out) {
     unsigned ti = s.body_type[i], tj = s.body_type[j];
     bool sphere_i = t.shape[ti] == NO_SHAPE, sphere_j = t.shape[tj] == NO_SHAPE;
     VolumeGeometry g;
@@ -220,11 +237,11 @@ static __device__ bool pair_contact(const ShapeTable& table, const PairStates& s
         RoundContact c;
         if (!sphere_pair(t.hertz, ti, tj, load3(s.position, i), load3(s.position, j),
                          load3(s.velocity, i), load3(s.velocity, j),
-                         load3(s.angular_momentum, i), load3(s.angular_momentum, j), before, dt,
-                         &c)) {
+                         load3(s.angular_momentum, i), load3(s.angular_momentum, j), before,
+                         roll.model, roll.spring, dt, &c)) {
             return false;
         }
-        *out = PairContact{c.force, c.torque, c.kept, 0.0, c.energy, c.dissipated};
+        *out = PairContact{c.force, c.torque, c.kept, twist, c.energy, c.dissipated, c.rolling};
         return true;
     }
     if (sphere_i && sphere_j) {
@@ -236,13 +253,14 @@ static __device__ bool pair_contact(const ShapeTable& table, const PairStates& s
             return false;
         }
         if (!round_volume) {
-            *out = hertz_cap(s, t, i, j, g, before, dt);
+            *out = hertz_cap(s, t, i, j, g, before, roll, dt);
+            out->twist = twist;
             return true;
         }
     } else if (!overlap_geometry(table, s, t, i, j, &g)) {
         return false;
     }
-    *out = volume_pair(s, t, i, j, g, before, twist, dt);
+    *out = volume_pair(s, t, i, j, g, before, twist, roll.spring, dt);
     return true;
 }
 
@@ -251,12 +269,14 @@ static __device__ bool pair_contact(const ShapeTable& table, const PairStates& s
 // (pair_contact) into the pair's result, its history replaced by what the contact
 // leaves; apart, a zero result and history, and the friction spring's energy as
 // dissipated (engine/cpu/pairs.rs). The result, energy terms and byte are
-// spheres.cu's (the gather and the sums read both alike); the history is
-// VOLUME_HISTORY_DOUBLES, whatever the pair. Per body type: its shape (NO_SHAPE: a
+// spheres.cu's (the gather and the sums read both alike). Per body type: its
+// shape (NO_SHAPE: a
 // sphere), mass, principal moments, whether they are equal, its volume-law row and
 // material; per pair of materials (row-major) its volume-law row; and the spheres'
 // Hertz–Mindlin table (contact.cuh, HertzTable). Spheres follow the volume law
-// where `round_volume` is 1, Hertz–Mindlin where 0.
+// where `round_volume` is 1, Hertz–Mindlin where 0, with the rolling resistance
+// `rolling_model` (contact.cuh). A pair's history is `history_doubles` long: the
+// spring (3), its stiffness, the twist, and where 8 the rolling spring (3).
 extern "C" __global__ void polyhedron_contacts(
     unsigned pair_count, double dt, const unsigned* pairs, const double* position,
     const double* orientation, const double* velocity, const double* angular_momentum,
@@ -266,9 +286,10 @@ extern "C" __global__ void polyhedron_contacts(
     const unsigned* type_shape, const unsigned* shape_index, const unsigned* face_span,
     const unsigned* loops, const Mask* face_masks, const double* vertices, const double* planes,
     const double* circumradius, const double* type_radius, const double* type_inverse_mass,
-    const double* type_inverse_inertia, const unsigned* hertz_material, unsigned hertz_materials,
-    const double* material_pairs, unsigned round_volume, double* history, double* results,
-    double* energies, unsigned char* touching) {
+    const double* type_inverse_inertia, const double* type_rolling_inertia,
+    const unsigned* hertz_material, unsigned hertz_materials, const double* material_pairs,
+    unsigned round_volume, unsigned history_doubles, unsigned rolling_model, double* history,
+    double* results, double* energies, unsigned char* touching) {
     unsigned e = blockIdx.x * blockDim.x + threadIdx.x;
     if (e >= pair_count) {
         return;
@@ -281,19 +302,21 @@ extern "C" __global__ void polyhedron_contacts(
         type_mass,   type_inertia,  type_isotropic,
         type_law,    type_material, materials,
         material_law, type_shape,
-        HertzTable{type_radius, type_inverse_mass, type_inverse_inertia, hertz_material,
-                   hertz_materials, material_pairs}};
+        HertzTable{type_radius, type_inverse_mass, type_inverse_inertia, type_rolling_inertia,
+                   hertz_material, hertz_materials, material_pairs}};
     unsigned i = pairs[2 * e], j = pairs[2 * e + 1];
-    double* h = history + VOLUME_HISTORY_DOUBLES * e;
+    double* h = history + (size_t)history_doubles * e;
+    bool rolls = history_doubles >= ROLLING_HISTORY_DOUBLES;
     double* result = results + RESULT_DOUBLES * e;
     double* energy = energies + PAIR_ENERGY_DOUBLES * e;
     bool counted = counts_pair(role[i], role[j]);
     unsigned char counted_flag = counted ? PAIR_COUNTED : 0u;
     Spring before = Spring{load3(h, 0), h[3]};
+    Rolling roll = Rolling{rolling_model, 0.0, rolls ? load3(h + 5, 0) : Vec3{0.0, 0.0, 0.0}};
     PairContact c;
     bool touches = !(role[i] && role[j]) &&
-                   pair_contact(table, states, types, round_volume != 0, i, j, before, h[4], dt,
-                                &c);
+                   pair_contact(table, states, types, round_volume != 0, i, j, before, h[4], roll,
+                                dt, &c);
     if (!touches) {
         for (unsigned k = 0; k < RESULT_DOUBLES; ++k) {
             result[k] = 0.0;
@@ -302,7 +325,7 @@ extern "C" __global__ void polyhedron_contacts(
         energy[0] = 0.0;
         energy[1] = counted ? spring_energy(before) : 0.0;
         touching[e] = counted_flag;
-        for (unsigned k = 0; k < VOLUME_HISTORY_DOUBLES; ++k) {
+        for (unsigned k = 0; k < history_doubles; ++k) {
             h[k] = 0.0;
         }
         return;
@@ -318,6 +341,9 @@ extern "C" __global__ void polyhedron_contacts(
     store3(h, 0, c.kept.spring);
     h[3] = c.kept.stiffness;
     h[4] = c.twist;
+    if (rolls) {
+        store3(h + 5, 0, c.rolling);
+    }
 }
 
 // One thread per query: shape `shapes[k]` against the triangle `triangles[9k..]`
@@ -415,7 +441,9 @@ extern "C" __global__ void polyhedron_wall_patches(
 // pairs' gather (engine/cpu/walls.rs, particle_contacts and patch_force): keys,
 // springs, records (triangle.cuh) and each contact's patch slot into the
 // particle's slots, their count into `count`. Per wall its material and motion
-// (velocity, angular velocity, reference point).
+// (velocity, angular velocity, reference point). A slot's history is
+// `history_doubles` long (polyhedron_contacts' layout; a rolling spring kept as it
+// was).
 extern "C" __global__ void polyhedron_wall_contacts(
     unsigned n, double dt, const double* position, const double* orientation,
     const double* velocity, const double* angular_momentum, const unsigned* body_type,
@@ -424,7 +452,8 @@ extern "C" __global__ void polyhedron_wall_contacts(
     const double* material_law, const unsigned* wall_material, const double* wall_motion,
     const unsigned* patch_count, const unsigned* patch_wall, const long long* patch_keys,
     const double* patch_geometry, const unsigned* patch_shares, const double* share_volume,
-    const unsigned* old_count, const long long* old_keys, const double* old_history,
+    unsigned history_doubles, const unsigned* old_count, const long long* old_keys,
+    const double* old_history,
     unsigned* count, long long* keys, double* history, double* records, unsigned* record_patch,
     double* force, double* torque, unsigned char* touching) {
     unsigned i = blockIdx.x * blockDim.x + threadIdx.x;
@@ -477,18 +506,25 @@ extern "C" __global__ void polyhedron_wall_contacts(
         }
         Spring before = Spring{Vec3{0.0, 0.0, 0.0}, 0.0};
         double twist = 0.0;
+        Vec3 rolling = Vec3{0.0, 0.0, 0.0};
         unsigned held = held_slot(old_keys + KEY_WORDS * WALL_SLOTS * i, old_count[i], key);
         if (held < old_count[i]) {
-            const double* h = old_history + VOLUME_HISTORY_DOUBLES * (WALL_SLOTS * i + held);
+            const double* h = old_history + (size_t)history_doubles * (WALL_SLOTS * i + held);
             before = Spring{load3(h, 0), h[3]};
             twist = h[4];
+            if (history_doubles >= ROLLING_HISTORY_DOUBLES) {
+                rolling = load3(h + 5, 0);
+            }
         }
         VolumeContact c = volume_contact(g, motion, normal_stiffness, tangential_stiffness,
                                          law[2], law[3], m, before, twist, dt, x);
-        double* h = history + VOLUME_HISTORY_DOUBLES * out;
+        double* h = history + (size_t)history_doubles * out;
         store3(h, 0, c.kept.spring);
         h[3] = c.kept.stiffness;
         h[4] = c.twist;
+        if (history_doubles >= ROLLING_HISTORY_DOUBLES) {
+            store3(h + 5, 0, rolling);
+        }
         // The facets' total share (a serial sum, as the CPU's).
         double total = 0.0;
         for (unsigned k = 0; k < patch_shares[slot]; ++k) {

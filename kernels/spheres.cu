@@ -3,31 +3,32 @@
 // gather of every particle's forces (engine/cpu/pairs.rs): the CPU backend's
 // operations in its order, so the same bits.
 //
-// The law is contact.cuh's. Layouts: per body type its radius, 1/m, 1/I, m and
-// material; per pair of materials (row-major) E*, G*, β, √(4G*/E*) and the friction
-// coefficient; per pair its tangential history (spring, 3 doubles, and the stiffness it was stretched at)
-// and its result (force on the second particle, torque on the first and on the
+// The law is contact.cuh's. Layouts: per body type its Hertz–Mindlin table
+// (contact.cuh, HertzTable); per pair its tangential history (spring, 3 doubles,
+// and the stiffness it was stretched at) and its result (force on the second particle, torque on the first and on the
 // second: 9 doubles), its energy terms (elastic energy, energy dissipated: apart
 // from the results, so that their sums read them in a row; zero where this world
 // does not count the pair) and its byte (contact.cuh: touches, counted). Per
 // particle its role (contact.cuh: frozen, ghost).
 
-// One thread per candidate pair: its contact, if the spheres overlap and one of
-// them moves here (is neither frozen nor a ghost), into its result; its history
-// replaced by what the contact leaves (none when apart).
+// One thread per candidate pair: its contact without rolling resistance, if the
+// spheres overlap and one of them moves here (is neither frozen nor a ghost), into
+// its result; its history replaced by what the contact leaves (none when apart).
 extern "C" __global__ void sphere_contacts(
     unsigned pair_count, double dt, const unsigned* pairs, const double* position,
     const double* velocity, const double* angular_momentum, const unsigned* body_type,
     const unsigned char* role, const double* type_radius, const double* type_inverse_mass,
-    const double* type_inverse_inertia, const unsigned* type_material, unsigned materials,
-    const double* material_pairs, double* history, double* results, double* energies,
-    unsigned char* touching) {
+    const double* type_inverse_inertia, const double* type_rolling_inertia,
+    const unsigned* type_material, unsigned materials, const double* material_pairs,
+    double* history, double* results, double* energies, unsigned char* touching) {
     unsigned e = blockIdx.x * blockDim.x + threadIdx.x;
     if (e >= pair_count) {
         return;
     }
-    HertzTable table = HertzTable{type_radius, type_inverse_mass, type_inverse_inertia,
-                                  type_material, materials, material_pairs};
+    HertzTable table = HertzTable{type_radius,         type_inverse_mass,
+                                  type_inverse_inertia, type_rolling_inertia,
+                                  type_material,        materials,
+                                  material_pairs};
     unsigned i = pairs[2 * e], j = pairs[2 * e + 1];
     bool counted = counts_pair(role[i], role[j]);
     unsigned char counted_flag = counted ? PAIR_COUNTED : 0u;
@@ -40,7 +41,8 @@ extern "C" __global__ void sphere_contacts(
     bool contact = !(role[i] && role[j]) &&
                    sphere_pair(table, body_type[i], body_type[j], xi, xj, load3(velocity, i),
                                load3(velocity, j), load3(angular_momentum, i),
-                               load3(angular_momentum, j), before, dt, &c);
+                               load3(angular_momentum, j), before, ROLLING_NONE,
+                               Vec3{0.0, 0.0, 0.0}, dt, &c);
     if (!contact) {
         bool held = before.spring.x != 0.0 || before.spring.y != 0.0 || before.spring.z != 0.0;
         for (unsigned k = 0; k < RESULT_DOUBLES; ++k) {

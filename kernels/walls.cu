@@ -54,16 +54,18 @@ static __device__ __forceinline__ bool sphere_facet(const double* t, Vec3 centre
 // polyhedra and spheres: polyhedra.cu writes those). Where `round_volume` is 1 the
 // contact follows the volume law (volume_law.cuh, engine/cpu/walls.rs patch_force:
 // per body type its law row, per pair of materials the volume law's), where 0
-// Hertz–Mindlin. A slot's history is `history_doubles` long (4, or 5: the twist,
-// 0 under Hertz–Mindlin).
+// Hertz–Mindlin with the rolling resistance `rolling_model` (contact.cuh; per body
+// type its rolling inertia about a contact on its surface). A slot's history is
+// `history_doubles` long: the spring (3) and its stiffness; where 5 or more the
+// twist (0 under Hertz–Mindlin); where 8 the rolling spring (3).
 // `overflow` is set when a particle has more than WALL_SLOTS contacts.
 extern "C" __global__ void sphere_walls(
     unsigned n, double dt, const double* position, const double* velocity,
     const double* orientation, const double* angular_momentum, const unsigned* body_type,
     const unsigned char* role, const unsigned char* type_sphere, const double* type_radius,
-    const double* type_mass, const double* type_inertia, const unsigned* type_material,
-    unsigned materials, const double* material_pairs, unsigned round_volume,
-    const double* type_law, const double* material_law, unsigned walls, const unsigned* wall_facets,
+    const double* type_mass, const double* type_inertia, const double* type_rolling_inertia,
+    const unsigned* type_material, unsigned materials, const double* material_pairs,
+    unsigned round_volume, unsigned rolling_model, const double* type_law, const double* material_law, unsigned walls, const unsigned* wall_facets,
     const double* facets, const double* facet_normals, const unsigned* wall_material,
     const double* wall_motion, unsigned history_doubles, const unsigned* old_count,
     const long long* old_keys, const double* old_springs, unsigned* count, long long* keys,
@@ -160,11 +162,13 @@ extern "C" __global__ void sphere_walls(
             }
             Spring before = Spring{Vec3{0.0, 0.0, 0.0}, 0.0};
             double twist = 0.0;
+            Vec3 rolling = Vec3{0.0, 0.0, 0.0};
             unsigned held = held_slot(old_keys + KEY_WORDS * WALL_SLOTS * i, old_count[i], key);
             if (held < old_count[i]) {
                 const double* h = old_springs + history_doubles * (WALL_SLOTS * i + held);
                 before = Spring{load3(h, 0), h[3]};
                 twist = history_doubles > HISTORY_DOUBLES ? h[4] : 0.0;
+                rolling = history_doubles >= 8 ? load3(h + 5, 0) : rolling;
             }
             RoundContact c;
             if (round_volume) {
@@ -186,18 +190,21 @@ extern "C" __global__ void sphere_walls(
                     volume_contact(vg, motion, row[2 + DAMPING_NODES] / law[5],
                                    row[3 + DAMPING_NODES] / law[5], law[2], law[3], row, before,
                                    twist, dt, x);
-                c = RoundContact{v.force, v.torque, v.kept, v.energy, v.dissipated};
+                c = RoundContact{v.force, v.torque, v.kept, v.energy, v.dissipated, rolling};
                 twist = v.twist;
             } else {
+                Rolling roll = Rolling{rolling_model, type_rolling_inertia[kind], rolling};
                 c = round_contact(g.depth, g.normal, lever, relative, sub(spin, wall_spin),
-                                  inverse_mass, r, m, before, dt);
-                twist = 0.0;
+                                  inverse_mass, r, m, before, roll, dt);
             }
             double* h = springs + history_doubles * (WALL_SLOTS * i + made);
             store3(h, 0, c.kept.spring);
             h[3] = c.kept.stiffness;
             if (history_doubles > HISTORY_DOUBLES) {
                 h[4] = twist;
+            }
+            if (history_doubles >= 8) {
+                store3(h + 5, 0, c.rolling);
             }
             double* record = records + WALL_RECORD_DOUBLES * (WALL_SLOTS * i + made);
             store3(record, 0, c.force);

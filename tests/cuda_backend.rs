@@ -157,22 +157,29 @@ fn a_scene_asking_for_the_cuda_backend_is_checked_when_read() {
             )
         ),
     }
-    // Spheres under the volume law are stepped; rolling resistance is refused.
+    // Spheres under the volume law and with rolling resistance are stepped; a
+    // polyhedron beyond the kernels' 64 faces and vertices is refused.
     let volume = cuda.replace("law = \"hertz_mindlin\"", "law = \"volume\"");
-    match Scene::parse(&volume, Path::new("pour.toml")) {
-        Ok(_) => assert!(talus::engine::cuda::driver::CudaDevice::is_present()),
-        Err(e) => assert!(e.to_string().contains("no CUDA driver"), "{e}"),
-    }
     let rolling = cuda.replace(
         "law = \"hertz_mindlin\"",
         "law = \"hertz_mindlin\"\nrolling = \"elastic_plastic\"",
     );
-    let e = Scene::parse(&rolling, Path::new("pour.toml")).unwrap_err();
+    for text in [volume, rolling] {
+        match Scene::parse(&text, Path::new("pour.toml")) {
+            Ok(_) => assert!(talus::engine::cuda::driver::CudaDevice::is_present()),
+            Err(e) => assert!(e.to_string().contains("no CUDA driver"), "{e}"),
+        }
+    }
+    let round = cuda.replace(
+        "kind = \"sphere\"\nradius = 0.004",
+        "kind = \"icosphere\"\nlevel = 2\nradius = 0.004",
+    );
+    let e = Scene::parse(&round, Path::new("pour.toml")).unwrap_err();
     assert_eq!(
         e.to_string(),
         format!(
-            "pour.toml:{line}: simulation.backend: the cuda backend does not yet step rolling \
-             resistance"
+            "pour.toml:{line}: simulation.backend: the cuda backend does not yet step body type \
+             0, a polyhedron of 162 vertices and 320 faces (at most 64 of each)"
         )
     );
     // Polyhedra are stepped (under the volume law), and so are spheres and

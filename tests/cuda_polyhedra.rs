@@ -471,6 +471,38 @@ fn spheres_and_polyhedra_under_the_volume_law_run_as_on_the_cpu_backend_to_round
     run.within(1e-8);
 }
 
+/// The beads and dodecahedra with the beads' elastic–plastic rolling resistance
+/// (rolling friction 0.05, damping 0.3), against beads and against the
+/// dodecahedra's faces (rolling inertia about the contact point of either body).
+#[test]
+fn spheres_with_rolling_resistance_on_polyhedra_run_as_on_the_cpu_backend_to_round_off() {
+    let text = MIXED
+        .replace(
+            "law = \"hertz_mindlin\"",
+            "law = \"hertz_mindlin\"\nrolling = \"elastic_plastic\"",
+        )
+        .replace(
+            "friction = 0.6\n",
+            "friction = 0.6\nrolling_friction = 0.05\nrolling_damping = 0.3\n",
+        )
+        .replace(
+            "friction = 0.4\n",
+            "friction = 0.4\nrolling_friction = 0.05\nrolling_damping = 0.3\n",
+        );
+    let scene = Scene::parse(&text, Path::new("mixed_pour.toml")).unwrap();
+    assert!(
+        scene
+            .world
+            .materials
+            .iter()
+            .all(|m| m.rolling_friction == 0.05)
+    );
+    let run = drift(Box::new(HostDevice::new(64)), &scene, 2000, 0.005);
+    assert!(run.most.0 > 40 && run.most.1 > 20, "{:?}", run.most);
+    assert!(run.kinds.iter().all(|&k| k > 8), "{:?}", run.kinds);
+    run.within(1e-8);
+}
+
 /// Dodecahedra and cubes in a quasi-2D drum turning at 3 rad/s, its end plates
 /// attached to the shell (walls whose facets are placed anew every step): 3400
 /// steps as the bed falls onto the shell and gathers. (Soon after, the bed's

@@ -18,8 +18,9 @@ use super::device::{Arg, Array, Device, DeviceError};
 use super::device_hertz::HertzTypes;
 use super::device_polyhedra::{DeviceShapes, ShapeTableError};
 use super::device_states::{DeviceStates, StateView};
+use super::device_wall_slots::{history_of, history_row};
 use crate::Real;
-use crate::contact::TangentialHistory;
+use crate::contact::{RollingModel, TangentialHistory};
 use crate::engine::laws::ContactLaws;
 use crate::engine::params::RoundLaw;
 use crate::geometry::{ConvexPolyhedron, is_isotropic};
@@ -35,6 +36,10 @@ const DAMPING_NODES: usize = 21;
 const MATERIAL_LAW: usize = 4 + DAMPING_NODES;
 /// Doubles of a contact's history (`VOLUME_HISTORY_DOUBLES`).
 pub(super) const HISTORY: usize = 5;
+/// Doubles of a Hertz–Mindlin history without twist (`HISTORY_DOUBLES`).
+const SPRING: usize = 4;
+/// Doubles of a history with a rolling spring (`ROLLING_HISTORY_DOUBLES`).
+const ROLLING_HISTORY: usize = 8;
 /// Doubles of a pair's result and energy terms (`RESULT_DOUBLES` and
 /// `PAIR_ENERGY_DOUBLES` of contact.cuh).
 const RESULT: usize = 9;
@@ -60,6 +65,9 @@ pub struct DeviceBodyTypes {
     pub(super) polyhedra: bool,
     /// Whether spheres follow the volume law (else Hertz–Mindlin).
     pub(super) round_volume: bool,
+    /// The spheres' rolling resistance under Hertz–Mindlin (`ROLLING_*` of
+    /// contact.cuh).
+    pub(super) rolling: u32,
     mass: Array<Real>,
     /// Principal moments, three per type.
     inertia: Array<Real>,
@@ -87,6 +95,25 @@ impl DeviceBodyTypes {
             Arg::U32(self.material_count),
             self.material_law.arg(),
         ]
+    }
+
+    /// Whether every contact is a sphere's under Hertz–Mindlin without rolling
+    /// resistance (`sphere_contacts` steps the pairs).
+    pub(super) fn spheres_under_hertz(&self) -> bool {
+        !self.polyhedra && !self.round_volume && self.rolling == 0
+    }
+
+    /// Doubles of a contact's tangential history: the spring and its stiffness
+    /// (4: spheres under Hertz–Mindlin alone), the twist (5), and with rolling
+    /// resistance the rolling spring (8).
+    pub(super) fn history_width(&self) -> usize {
+        if self.rolling != 0 {
+            ROLLING_HISTORY
+        } else if self.spheres_under_hertz() {
+            SPRING
+        } else {
+            HISTORY
+        }
     }
 
     /// Bytes of device memory held.
@@ -158,6 +185,14 @@ impl DeviceBodyTypes {
         let mut uploaded = DeviceBodyTypes {
             polyhedra: !distinct.is_empty(),
             round_volume: round == RoundLaw::Volume,
+            rolling: match round {
+                RoundLaw::HertzMindlin { rolling } => match rolling {
+                    RollingModel::None => 0,
+                    RollingModel::ConstantTorque => 1,
+                    RollingModel::ElasticPlastic => 2,
+                },
+                RoundLaw::Volume => 0,
+            },
             shapes: DeviceShapes::upload(device, &distinct)?,
             hertz: HertzTypes::upload(device, world)?,
             material_count: laws.material_count() as u32,
@@ -238,6 +273,8 @@ pub(super) unsafe fn polyhedron_contacts(
     args.extend(types.hertz.args());
     args.extend([
         Arg::U32(u32::from(types.round_volume)),
+        Arg::U32(types.history_width() as u32),
+        Arg::U32(types.rolling),
         out.history.arg(),
         out.results.arg(),
         out.energies.arg(),
@@ -277,8 +314,7 @@ impl VolumeContacts {
         self.pairs.write(device, &flat)?;
         self.host.clear();
         for h in histories {
-            self.host.extend(h.spring.iter());
-            self.host.extend([h.stiffness, h.twist]);
+            self.host.extend(&history_row(h)[..HISTORY]);
         }
         self.history.write(device, &self.host)?;
         self.results.resize(device, RESULT * pairs.len())?;
@@ -334,15 +370,6 @@ impl VolumeContacts {
         device: &dyn Device,
     ) -> Result<Vec<TangentialHistory>, DeviceError> {
         self.history.read_into(device, &mut self.host)?;
-        Ok(self
-            .host
-            .chunks_exact(HISTORY)
-            .map(|h| TangentialHistory {
-                spring: Vector3::new(h[0], h[1], h[2]),
-                stiffness: h[3],
-                twist: h[4],
-                ..Default::default()
-            })
-            .collect())
+        Ok(self.host.chunks_exact(HISTORY).map(history_of).collect())
     }
 }

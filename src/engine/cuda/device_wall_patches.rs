@@ -231,6 +231,7 @@ pub(super) fn polyhedron_wall_contacts(
         patches.geometry.arg(),
         patches.shares.arg(),
         patches.share_volume.arg(),
+        Arg::U32(slots.width() as u32),
     ]);
     args.extend(slots.args());
     args.extend([loads.force.arg(), loads.torque.arg(), loads.touching.arg()]);

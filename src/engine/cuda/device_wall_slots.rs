@@ -46,6 +46,26 @@ pub struct WallContactResult {
     pub history: TangentialHistory,
 }
 
+/// A tangential history as the kernels keep it: the spring, its stiffness, the
+/// twist, the rolling spring (`kernels/polyhedra.cu`); a history of fewer doubles
+/// is the row's first ones.
+pub(super) fn history_row(h: &TangentialHistory) -> [Real; 8] {
+    let (s, r) = (&h.spring, &h.rolling);
+    [s.x, s.y, s.z, h.stiffness, h.twist, r.x, r.y, r.z]
+}
+
+/// The tangential history of a kernel's row of 4, 5 or 8 doubles (see
+/// [`history_row`]).
+pub(super) fn history_of(h: &[Real]) -> TangentialHistory {
+    let at = |k: usize| h.get(k).copied().unwrap_or(0.0);
+    TangentialHistory {
+        spring: Vector3::new(h[0], h[1], h[2]),
+        stiffness: h[3],
+        twist: at(4),
+        rolling: Vector3::new(at(5), at(6), at(7)),
+    }
+}
+
 /// The error of a particle touching walls at more places than it has slots for.
 pub(super) fn too_many_wall_contacts() -> DeviceError {
     DeviceError::Capacity(format!(
@@ -165,8 +185,7 @@ impl WallSlots {
             let slot = SLOTS * i + s;
             keys[KEY * slot] = *wall as i64;
             keys[KEY * slot + 1..KEY * slot + KEY].copy_from_slice(plane);
-            let kept = [h.spring.x, h.spring.y, h.spring.z, h.stiffness, h.twist];
-            springs[width * slot..width * (slot + 1)].copy_from_slice(&kept[..width]);
+            springs[width * slot..width * (slot + 1)].copy_from_slice(&history_row(h)[..width]);
             count[i] += 1;
         }
         self.new.count.write(device, &count)?;
@@ -201,12 +220,7 @@ impl WallSlots {
                 torque: v(r, 3),
                 energy: r[7],
                 dissipated: r[8],
-                history: TangentialHistory {
-                    spring: v(h, 0),
-                    stiffness: h[3],
-                    twist: if width > 4 { h[4] } else { 0.0 },
-                    ..Default::default()
-                },
+                history: history_of(h),
             }
         };
         Ok((count.iter().enumerate())

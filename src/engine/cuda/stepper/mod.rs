@@ -24,11 +24,11 @@
 //! count the pairs the rank counts (`Particles::counts_pair`).
 //!
 //! Spheres and polyhedra may share a world: two polyhedra meet under the volume
-//! law, a sphere meets anything under Hertz–Mindlin (a polyhedron as locally flat).
+//! law, a sphere meets anything under the scene's law (the volume law, or
+//! Hertz–Mindlin with its rolling resistance, a polyhedron as locally flat).
 //!
-//! What it does not take yet (refused by [`DeviceWorld::new`]): spheres under a law
-//! other than Hertz–Mindlin without rolling resistance, polyhedra of more than 64
-//! faces or vertices, a fluid.
+//! What it does not take yet (refused by [`DeviceWorld::new`]): polyhedra of more
+//! than 64 faces or vertices, a fluid.
 
 use nalgebra::{Point3, UnitQuaternion, Vector3};
 
@@ -42,23 +42,16 @@ use super::device_list::{DeviceList, ListInputs, run};
 use super::device_polyhedra::{MAX_SHAPE_PARTS, ShapeTableError};
 use super::device_states::{StateView, roles};
 use super::device_sums::{PairTerms, RowSums, sum_energies};
-use super::device_volume_contacts::{
-    DeviceBodyTypes, HISTORY as VOLUME_HISTORY, PairOutputs, polyhedron_contacts,
-};
+use super::device_volume_contacts::{DeviceBodyTypes, PairOutputs, polyhedron_contacts};
 use super::device_wall_patches::Loads;
 use super::device_wall_slots::too_many_wall_contacts;
 use super::device_walls::{DeviceWalls, WallInputs};
 use super::readback::Readback;
 use crate::Real;
-use crate::contact::RollingModel;
+use crate::engine::StepParams;
 use crate::engine::neighbours::automatic_skin;
-use crate::engine::{RoundLaw, StepParams};
 use crate::world::{Particles, World};
 
-/// Doubles of a Hertz–Mindlin pair's tangential history on the device: the spring
-/// and the stiffness it was stretched at (the volume law's adds its twist:
-/// [`VOLUME_HISTORY`]).
-const HISTORY: usize = 4;
 /// Doubles of a pair's result (`kernels/spheres.cu`).
 const RESULT: usize = 9;
 /// Doubles of a pair's energy terms (`kernels/spheres.cu`).
@@ -85,21 +78,15 @@ struct TypeArrays {
 }
 
 impl TypeArrays {
-    /// Whether every pair is two spheres under Hertz–Mindlin (`sphere_contacts`,
-    /// four doubles of history), else any pair of the world (`polyhedron_contacts`,
-    /// five doubles).
+    /// Whether every pair is two spheres under Hertz–Mindlin without rolling
+    /// resistance (`sphere_contacts`), else any pair (`polyhedron_contacts`).
     fn spheres_under_hertz(&self) -> bool {
-        !self.laws.polyhedra && !self.laws.round_volume
+        self.laws.spheres_under_hertz()
     }
 
-    /// Doubles of a contact's tangential history: the spring and its stiffness,
-    /// and but for spheres under Hertz–Mindlin alone the twist.
+    /// Doubles of a contact's tangential history.
     fn history_width(&self) -> usize {
-        if self.spheres_under_hertz() {
-            HISTORY
-        } else {
-            VOLUME_HISTORY
-        }
+        self.laws.history_width()
     }
 }
 
@@ -266,9 +253,10 @@ impl DeviceWorld {
         Ok(stepper)
     }
 
-    /// Whether the stepper models `world` under `params`: `Err` names what it does
+    /// Whether the stepper models `world` under `params` (every contact law of the
+    /// CPU backend is stepped: the world alone decides): `Err` names what it does
     /// not model yet.
-    pub fn check(world: &World, params: &StepParams) -> Result<(), StepperError> {
+    pub fn check(world: &World, _params: &StepParams) -> Result<(), StepperError> {
         let unsupported = |what: &str| Err(StepperError::Unsupported(what.into()));
         if world.fluid.is_some() {
             return unsupported("a fluid");
@@ -284,11 +272,6 @@ impl DeviceWorld {
                      most {MAX_SHAPE_PARTS} of each)"
                 ));
             }
-        }
-        let spheres = (world.body_types.iter()).any(|t| t.shape.as_sphere().is_some());
-        let rolling = matches!(params.round_law, RoundLaw::HertzMindlin { rolling } if rolling != RollingModel::None);
-        if spheres && rolling {
-            return unsupported("rolling resistance");
         }
         Ok(())
     }

@@ -6,9 +6,9 @@ use nalgebra::{Point3, Quaternion, UnitQuaternion, Vector3};
 
 use super::{DeviceWorld, in_order, points, quaternions, roles, vectors};
 use crate::Real;
-use crate::contact::TangentialHistory;
 use crate::engine::backend::ContactHistory;
 use crate::engine::cuda::device::{Array, Device, DeviceError};
+use crate::engine::cuda::device_wall_slots::{history_of, history_row};
 use crate::world::World;
 
 impl DeviceWorld {
@@ -89,10 +89,7 @@ impl DeviceWorld {
         let d = self.device.as_mut();
         let keys: Vec<u64> = history.pairs.iter().flat_map(|(k, _)| [k.0, k.1]).collect();
         let springs: Vec<Real> = (history.pairs.iter())
-            .flat_map(|(_, h)| {
-                let kept = [h.spring.x, h.spring.y, h.spring.z, h.stiffness, h.twist];
-                kept.into_iter().take(width)
-            })
+            .flat_map(|(_, h)| history_row(h).into_iter().take(width))
             .collect();
         self.list.old_keys.write(d, &keys)?;
         self.list.old_pair_count = history.pairs.len();
@@ -234,15 +231,7 @@ impl DeviceWorld {
         let pairs = keys
             .chunks_exact(2)
             .zip(history.chunks_exact(width))
-            .map(|(k, h)| {
-                let kept = TangentialHistory {
-                    spring: Vector3::new(h[0], h[1], h[2]),
-                    stiffness: h[3],
-                    twist: if width > 4 { h[4] } else { 0.0 },
-                    ..Default::default()
-                };
-                ((k[0], k[1]), kept)
-            })
+            .map(|(k, h)| ((k[0], k[1]), history_of(h)))
             .filter(|(_, h)| !h.is_empty())
             .collect();
         let ids = self.particles.id.read(d)?;
