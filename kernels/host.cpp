@@ -29,6 +29,7 @@ thread_local dim3 threadIdx, blockIdx, blockDim, gridDim;
 #include "halo.cu"
 #include "figures.cu"
 #include "polyhedra.cu"
+#include "pairs.cu"
 
 // Sets the built-ins of the calling thread before it runs one kernel thread.
 extern "C" void talus_host_at(unsigned block, unsigned thread, unsigned block_dim,
@@ -74,7 +75,7 @@ static const Entry kernels[] = {
     KERNEL(pair_energy_partials), KERNEL(sum_records),
     KERNEL(pack_states),       KERNEL(unpack_ghost_states), KERNEL(max_records),
     KERNEL(particle_figures),  KERNEL(polyhedron_overlaps),
-    KERNEL(polyhedron_contacts), KERNEL(polyhedron_facets),
+    KERNEL(pair_contacts), KERNEL(polyhedron_facets),
     KERNEL(polyhedron_wall_patches), KERNEL(polyhedron_wall_contacts),
     KERNEL(polyhedron_wall_sum_rows),
 };

@@ -67,6 +67,9 @@ static __device__ __forceinline__ Mask first_vertices(unsigned n) {
 
 // The shapes on the device (engine/cuda/device_polyhedra.rs), each in its body
 // frame with its centroid at the origin.
+// A body type's shape index where it has no shape in the table: a sphere.
+#define NO_SHAPE 0xffffffffu
+
 struct ShapeTable {
     // Per shape: its first vertex, vertex count, first face, face count.
     const unsigned* index;

@@ -19,8 +19,10 @@
 // (engine/laws.rs, ContactLaws::wall).
 #define MATERIAL_LAW_DOUBLES (4u + DAMPING_NODES)
 // A contact's history under the volume law: the friction spring, its stiffness,
-// the twist.
+// the twist; with a rolling spring after them (Hertz–Mindlin's rolling resistance
+// beside the volume law).
 #define VOLUME_HISTORY_DOUBLES 5u
+#define ROLLING_HISTORY_DOUBLES 8u
 
 // The damping ratio at exponent p, interpolated in the material pair's nodes
 // (contact/damping.rs, DampingTable::zeta).

@@ -11,8 +11,8 @@ use nalgebra::{Point3, Vector3};
 
 use super::Kernel;
 use super::device::{Arg, Array, Device, DeviceError};
+use super::device_body_types::DeviceBodyTypes;
 use super::device_states::StateView;
-use super::device_volume_contacts::DeviceBodyTypes;
 use super::device_wall_placement::PlacedWalls;
 use super::device_wall_slots::WallSlots;
 use crate::Real;

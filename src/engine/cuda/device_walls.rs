@@ -13,10 +13,10 @@ use nalgebra::Vector3;
 
 use super::Kernel;
 use super::device::{Arg, Array, Device, DeviceError};
+use super::device_body_types::DeviceBodyTypes;
 use super::device_list::run;
 use super::device_states::StateView;
 use super::device_sums::{RowSums, first_rows};
-use super::device_volume_contacts::DeviceBodyTypes;
 use super::device_wall_patches::{
     DeviceWallPatches, Loads, PolyhedronSums, polyhedron_wall_contacts, polyhedron_wall_sum_rows,
 };

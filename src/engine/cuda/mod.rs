@@ -15,12 +15,13 @@
 
 pub mod backend;
 pub mod device;
+pub mod device_body_types;
 mod device_hertz;
 mod device_list;
+pub mod device_pair_contacts;
 pub mod device_polyhedra;
 pub mod device_states;
 mod device_sums;
-pub mod device_volume_contacts;
 pub mod device_wall_patches;
 pub mod device_wall_placement;
 pub mod device_wall_slots;
@@ -109,7 +110,7 @@ pub static WALL_PATCHES: KernelFile = KernelFile {
 };
 
 /// The kernel files, each compiled to one module.
-pub static FILES: [KernelFile; 9] = [
+pub static FILES: [KernelFile; 10] = [
     KernelFile {
         name: "integrate.cu",
         source: include_str!("../../../kernels/integrate.cu"),
@@ -159,10 +160,22 @@ pub static FILES: [KernelFile; 9] = [
             &BODY,
             &TRIANGLE,
             &OVERLAP,
-            &ROUND_GEOMETRY,
             &VOLUME_LAW,
             &FACET,
             &WALL_PATCHES,
+        ],
+    },
+    KernelFile {
+        name: "pairs.cu",
+        source: include_str!("../../../kernels/pairs.cu"),
+        headers: &[
+            &VEC,
+            &CONTACT,
+            &BODY,
+            &TRIANGLE,
+            &OVERLAP,
+            &ROUND_GEOMETRY,
+            &VOLUME_LAW,
         ],
     },
 ];
@@ -230,8 +243,9 @@ pub enum Kernel {
     ParticleFigures,
     /// The overlap of each pair of convex polyhedra at its pose (`polyhedra.cu`).
     PolyhedronOverlaps,
-    /// The volume-law contacts of candidate pairs of polyhedra (`polyhedra.cu`).
-    PolyhedronContacts,
+    /// The contacts of the candidate pairs of any world but spheres under
+    /// Hertz–Mindlin alone (`pairs.cu`).
+    PairContacts,
     /// The overlap of polyhedra with the prisms under wall facets (`polyhedra.cu`).
     PolyhedronFacets,
     /// Each polyhedron's patches against the walls (`polyhedra.cu`).
@@ -276,7 +290,7 @@ impl Kernel {
         Kernel::MaxRecords,
         Kernel::ParticleFigures,
         Kernel::PolyhedronOverlaps,
-        Kernel::PolyhedronContacts,
+        Kernel::PairContacts,
         Kernel::PolyhedronFacets,
         Kernel::PolyhedronWallPatches,
         Kernel::PolyhedronWallContacts,
@@ -316,7 +330,7 @@ impl Kernel {
             Kernel::MaxRecords => "max_records",
             Kernel::ParticleFigures => "particle_figures",
             Kernel::PolyhedronOverlaps => "polyhedron_overlaps",
-            Kernel::PolyhedronContacts => "polyhedron_contacts",
+            Kernel::PairContacts => "pair_contacts",
             Kernel::PolyhedronFacets => "polyhedron_facets",
             Kernel::PolyhedronWallPatches => "polyhedron_wall_patches",
             Kernel::PolyhedronWallContacts => "polyhedron_wall_contacts",
@@ -340,11 +354,11 @@ impl Kernel {
             PackStates | UnpackGhostStates => 6,
             ParticleFigures => 7,
             PolyhedronOverlaps
-            | PolyhedronContacts
             | PolyhedronFacets
             | PolyhedronWallPatches
             | PolyhedronWallContacts
             | PolyhedronWallSumRows => 8,
+            PairContacts => 9,
         };
         &FILES[index]
     }

@@ -8,8 +8,9 @@ use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 
 use super::device::{Array, Device};
+use super::device_body_types::DeviceBodyTypes;
+use super::device_pair_contacts::PairContacts;
 use super::device_states::DeviceStates;
-use super::device_volume_contacts::*;
 use super::device_wall_patches::{DeviceWallPatches, Loads, PATCH_SLOTS, polyhedron_wall_contacts};
 use super::device_wall_placement::PlacedWalls;
 use super::device_wall_slots::WallSlots;
@@ -130,7 +131,7 @@ fn volume_contacts_equal_the_cpu_pair_stage() {
     let mut states = DeviceStates::default();
     states.upload(&mut device, &world.particles).unwrap();
     let list: Vec<(u32, u32)> = (0..pairs as u32).map(|k| (2 * k, 2 * k + 1)).collect();
-    let mut contacts = VolumeContacts::default();
+    let mut contacts = PairContacts::default();
     contacts.set_pairs(&mut device, &list, &histories).unwrap();
     contacts.evaluate(&mut device, &types, &states, dt).unwrap();
     let results = contacts.results(&device).unwrap();

@@ -38,11 +38,12 @@ mod transfer;
 
 use super::Kernel;
 use super::device::{Arg, Array, Device, DeviceError};
+use super::device_body_types::DeviceBodyTypes;
 use super::device_list::{DeviceList, ListInputs, run};
+use super::device_pair_contacts::{PairOutputs, pair_contacts};
 use super::device_polyhedra::{MAX_SHAPE_PARTS, ShapeTableError};
 use super::device_states::{StateView, roles};
 use super::device_sums::{PairTerms, RowSums, sum_energies};
-use super::device_volume_contacts::{DeviceBodyTypes, PairOutputs, polyhedron_contacts};
 use super::device_wall_patches::Loads;
 use super::device_wall_slots::too_many_wall_contacts;
 use super::device_walls::{DeviceWalls, WallInputs};
@@ -79,7 +80,7 @@ struct TypeArrays {
 
 impl TypeArrays {
     /// Whether every pair is two spheres under Hertz–Mindlin without rolling
-    /// resistance (`sphere_contacts`), else any pair (`polyhedron_contacts`).
+    /// resistance (`sphere_contacts`), else any pair (`pair_contacts`).
     fn spheres_under_hertz(&self) -> bool {
         self.laws.spheres_under_hertz()
     }
@@ -495,7 +496,7 @@ impl DeviceWorld {
             };
             // SAFETY: the states hold every particle of the list's pairs, the types
             // every body type; the outputs sized for `count` pairs.
-            unsafe { polyhedron_contacts(d, &t.laws, &states, count, &list.pairs, &out, dt)? };
+            unsafe { pair_contacts(d, &t.laws, &states, count, &list.pairs, &out, dt)? };
         }
         let g = self.gravity;
         // SAFETY: the parameters of gather_forces (spheres.cu), every array sized
