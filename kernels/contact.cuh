@@ -196,6 +196,36 @@ static __device__ RoundContact round_contact(double depth, Vec3 normal, Vec3 lev
 }
 
 
+// A candidate pair's outputs (spheres.cu, pairs.cu) where it is apart: a zero
+// result, and as its energy terms the friction spring `before` let go (where this
+// world counts the pair).
+static __device__ __forceinline__ void store_apart(double* result, double* energy,
+                                                   unsigned char* touching, bool counted,
+                                                   Spring before) {
+    for (unsigned k = 0; k < RESULT_DOUBLES; ++k) {
+        result[k] = 0.0;
+    }
+    energy[0] = 0.0;
+    energy[1] = counted ? spring_energy(before) : 0.0;
+    *touching = counted ? PAIR_COUNTED : 0u;
+}
+
+// A candidate pair's outputs where its particles, at xi and xj, touch: the force on
+// the second, the first's reaction torque and the second's torque, the energy
+// terms (where counted) and its byte.
+static __device__ __forceinline__ void store_contact(double* result, double* energy,
+                                                     unsigned char* touching, bool counted,
+                                                     Vec3 xi, Vec3 xj, Vec3 force, Vec3 torque,
+                                                     double elastic, double dissipated) {
+    Vec3 reaction = scale(add(torque, cross(sub(xj, xi), force)), -1.0);
+    store3(result, 0, force);
+    store3(result, 1, reaction);
+    store3(result, 2, torque);
+    energy[0] = counted ? elastic : 0.0;
+    energy[1] = counted ? dissipated : 0.0;
+    *touching = PAIR_TOUCHES | (counted ? PAIR_COUNTED : 0u);
+}
+
 // What the Hertz–Mindlin contacts of spheres read: per body type its radius, 1/m,
 // 1/I, rolling inertia about a contact on its surface (I + m r²) and material; per
 // pair of materials (row-major) its row (MATERIAL_DOUBLES).

@@ -276,7 +276,6 @@ extern "C" __global__ void pair_contacts(
     double* result = results + RESULT_DOUBLES * e;
     double* energy = energies + PAIR_ENERGY_DOUBLES * e;
     bool counted = counts_pair(role[i], role[j]);
-    unsigned char counted_flag = counted ? PAIR_COUNTED : 0u;
     Spring before = Spring{load3(h, 0), h[3]};
     Rolling roll = Rolling{rolling_model, 0.0, rolls ? load3(h + 5, 0) : Vec3{0.0, 0.0, 0.0}};
     PairContact c;
@@ -284,26 +283,14 @@ extern "C" __global__ void pair_contacts(
                    pair_contact(table, states, types, round_volume != 0, i, j, before, h[4], roll,
                                 dt, &c);
     if (!touches) {
-        for (unsigned k = 0; k < RESULT_DOUBLES; ++k) {
-            result[k] = 0.0;
-        }
-        // The friction spring's energy is let go with the contact.
-        energy[0] = 0.0;
-        energy[1] = counted ? spring_energy(before) : 0.0;
-        touching[e] = counted_flag;
+        store_apart(result, energy, touching + e, counted, before);
         for (unsigned k = 0; k < history_doubles; ++k) {
             h[k] = 0.0;
         }
         return;
     }
-    Vec3 xi = load3(position, i), xj = load3(position, j);
-    Vec3 reaction = scale(add(c.torque, cross(sub(xj, xi), c.force)), -1.0);
-    store3(result, 0, c.force);
-    store3(result, 1, reaction);
-    store3(result, 2, c.torque);
-    energy[0] = counted ? c.energy : 0.0;
-    energy[1] = counted ? c.dissipated : 0.0;
-    touching[e] = PAIR_TOUCHES | counted_flag;
+    store_contact(result, energy, touching + e, counted, load3(position, i), load3(position, j),
+                  c.force, c.torque, c.energy, c.dissipated);
     store3(h, 0, c.kept.spring);
     h[3] = c.kept.stiffness;
     h[4] = c.twist;

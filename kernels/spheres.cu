@@ -31,7 +31,6 @@ extern "C" __global__ void sphere_contacts(
                                   material_pairs};
     unsigned i = pairs[2 * e], j = pairs[2 * e + 1];
     bool counted = counts_pair(role[i], role[j]);
-    unsigned char counted_flag = counted ? PAIR_COUNTED : 0u;
     Spring before = Spring{load3(history + HISTORY_DOUBLES * e, 0),
                            history[HISTORY_DOUBLES * e + 3]};
     double* result = results + RESULT_DOUBLES * e;
@@ -44,29 +43,15 @@ extern "C" __global__ void sphere_contacts(
                                load3(angular_momentum, j), before, ROLLING_NONE,
                                Vec3{0.0, 0.0, 0.0}, dt, &c);
     if (!contact) {
+        store_apart(result, energy, touching + e, counted, before);
         bool held = before.spring.x != 0.0 || before.spring.y != 0.0 || before.spring.z != 0.0;
-        for (unsigned k = 0; k < RESULT_DOUBLES; ++k) {
-            result[k] = 0.0;
-        }
-        energy[0] = 0.0;
-        energy[1] = 0.0;
-        touching[e] = counted_flag;
-        if (held) {
-            // The friction spring's energy is let go with the contact.
-            energy[1] = counted ? spring_energy(before) : 0.0;
-            for (unsigned k = 0; k < HISTORY_DOUBLES; ++k) {
-                history[HISTORY_DOUBLES * e + k] = 0.0;
-            }
+        for (unsigned k = 0; held && k < HISTORY_DOUBLES; ++k) {
+            history[HISTORY_DOUBLES * e + k] = 0.0;
         }
         return;
     }
-    Vec3 reaction = scale(add(c.torque, cross(sub(xj, xi), c.force)), -1.0);
-    store3(result, 0, c.force);
-    store3(result, 1, reaction);
-    store3(result, 2, c.torque);
-    energy[0] = counted ? c.energy : 0.0;
-    energy[1] = counted ? c.dissipated : 0.0;
-    touching[e] = PAIR_TOUCHES | counted_flag;
+    store_contact(result, energy, touching + e, counted, xi, xj, c.force, c.torque, c.energy,
+                  c.dissipated);
     history[HISTORY_DOUBLES * e] = c.kept.spring.x;
     history[HISTORY_DOUBLES * e + 1] = c.kept.spring.y;
     history[HISTORY_DOUBLES * e + 2] = c.kept.spring.z;
