@@ -11,7 +11,8 @@
 #                                     cuda_backend and cuda_polyhedra (`cargo test --release --features
 #                                     cuda --no-run` names them, with a hash)
 # What it runs: every kernel compiled by NVRTC for sm_80 and sm_90
-# (tests/cuda_kernels.rs); the converging cloud, the cloud thrown into a box and the
+# (tests/cuda_kernels.rs); the converging cloud, the cloud thrown into a box (both
+# also under the volume law, the thrown one with either rolling resistance) and the
 # turning drum on GPU 0 against the CPU backend, the particles to the bit and the
 # sums to 1e-12 (tests/cuda_spheres.rs, `on_a_gpu_...`); the backend under a whole
 # simulation through the host executor (tests/cuda_backend.rs); the polyhedra's

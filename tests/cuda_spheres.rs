@@ -253,15 +253,32 @@ fn a_converging_cloud_steps_as_the_cpu_backend_to_the_bit() {
 type Run = fn(Box<dyn Device>);
 
 /// The same runs on a GPU, where there is one (`scripts/gpu-check.sh`): the
-/// converging cloud, the cloud thrown into a box, the turning drum, and both
-/// clouds as a rank's share with ghosts. The kernels
+/// converging cloud, the cloud thrown into a box, both under the volume law, the
+/// thrown cloud with either rolling resistance, the turning drum, and both clouds
+/// as a rank's share with ghosts. The kernels
 /// are compiled without fused multiply–adds and with IEEE division and square
 /// roots, and the only atomics are on integers, so the GPU gives the same bits.
 /// Without a driver the test says so and passes, unless `TALUS_REQUIRE_GPU` is set.
 #[test]
 fn on_a_gpu_the_cloud_the_box_and_the_drum_step_as_the_cpu_backend_to_the_bit() {
-    let runs: [(&str, Run); 5] = [
+    let runs: [(&str, Run); 9] = [
         ("the converging cloud", steps_as_the_cpu_backend),
+        (
+            "the converging cloud under the volume law",
+            converging_under_the_volume_law,
+        ),
+        (
+            "the cloud thrown into a box under the volume law",
+            thrown_under_the_volume_law,
+        ),
+        (
+            "the cloud thrown into a box, constant rolling torque",
+            thrown_with_constant_rolling_torque,
+        ),
+        (
+            "the cloud thrown into a box, rolling spring",
+            thrown_with_a_rolling_spring,
+        ),
         ("the cloud thrown into a box", thrown_into_a_box),
         ("the turning drum", beads_in_a_turning_drum),
         ("a rank's share of the converging cloud", converging_share),
@@ -318,26 +335,74 @@ fn thrown_into_a_box(device: Box<dyn Device>) {
 /// into the box (1000 steps).
 #[test]
 fn clouds_under_the_volume_law_step_as_the_cpu_backend_to_the_bit() {
-    let volume = |(world, mut params): (World, StepParams)| {
-        params.round_law = talus::engine::RoundLaw::Volume;
-        (world, params)
-    };
-    let (start, params) = volume(cloud());
-    let run = parity(host(64), &start, &params, 1000, false);
+    converging_under_the_volume_law(host(64));
+    thrown_under_the_volume_law(host(64));
+}
+
+/// `(world, params)` under the volume law.
+fn under_the_volume_law((world, mut params): (World, StepParams)) -> (World, StepParams) {
+    params.round_law = talus::engine::RoundLaw::Volume;
+    (world, params)
+}
+
+fn converging_under_the_volume_law(device: Box<dyn Device>) {
+    let (start, params) = under_the_volume_law(cloud());
+    let run = parity(device, &start, &params, 1000, false);
     eprintln!("converging: {} contacts at most", run.most_contacts);
     assert!(
         run.most_contacts > 500,
         "{} contacts at most",
         run.most_contacts
     );
-    let (start, params) = volume(cloud_in(OPEN_BOX, 30.0));
-    let run = parity(host(64), &start, &params, 1000, false);
+}
+
+fn thrown_under_the_volume_law(device: Box<dyn Device>) {
+    let (start, params) = under_the_volume_law(cloud_in(OPEN_BOX, 30.0));
+    let run = parity(device, &start, &params, 1000, false);
     eprintln!(
         "thrown: {} wall contacts, {} contacts at most",
         run.most_wall_contacts, run.most_contacts
     );
     assert!(
         run.most_wall_contacts > 40 && run.most_contacts > 60,
+        "{} wall contacts, {} contacts at most",
+        run.most_wall_contacts,
+        run.most_contacts
+    );
+}
+
+/// The cloud thrown into the box with rolling resistance under Hertz–Mindlin
+/// (materials of rolling friction 0.05 and damping 0.3): the constant torque and
+/// the elastic–plastic spring–dashpot, whose spring every pair and wall contact
+/// keeps, 1000 steps each, the CPU backend's bits.
+#[test]
+fn clouds_with_rolling_resistance_step_as_the_cpu_backend_to_the_bit() {
+    thrown_with_constant_rolling_torque(host(64));
+    thrown_with_a_rolling_spring(host(64));
+}
+
+fn thrown_with_constant_rolling_torque(device: Box<dyn Device>) {
+    thrown_with_rolling(device, talus::contact::RollingModel::ConstantTorque);
+}
+
+fn thrown_with_a_rolling_spring(device: Box<dyn Device>) {
+    thrown_with_rolling(device, talus::contact::RollingModel::ElasticPlastic);
+}
+
+fn thrown_with_rolling(device: Box<dyn Device>, rolling: talus::contact::RollingModel) {
+    let (mut start, mut params) = cloud_in(OPEN_BOX, 30.0);
+    for m in &mut start.materials {
+        m.rolling_friction = 0.05;
+        m.rolling_damping = 0.3;
+    }
+    params.round_law = talus::engine::RoundLaw::HertzMindlin { rolling };
+    let run = parity(device, &start, &params, 1000, false);
+    eprintln!(
+        "{rolling:?}: {} wall contacts, {} contacts at most",
+        run.most_wall_contacts, run.most_contacts
+    );
+    assert!(
+        run.most_wall_contacts > 100 && run.most_contacts > 100,
         "{} wall contacts, {} contacts at most",
         run.most_wall_contacts,
         run.most_contacts
@@ -509,34 +574,6 @@ fn share_with_ghosts(device: Box<dyn Device>, spread: f64) -> Parity {
     assert!(!p.id.is_sorted());
     assert!((p.owned()..p.len()).any(|i| p.frozen[i]));
     parity(device, &start, &params, 1000, false)
-}
-
-/// The cloud thrown into the box with rolling resistance under Hertz–Mindlin
-/// (materials of rolling friction 0.05 and damping 0.3): the constant torque and
-/// the elastic–plastic spring–dashpot, whose spring every pair and wall contact
-/// keeps, 1000 steps each, the CPU backend's bits.
-#[test]
-fn clouds_with_rolling_resistance_step_as_the_cpu_backend_to_the_bit() {
-    use talus::contact::RollingModel;
-    for rolling in [RollingModel::ConstantTorque, RollingModel::ElasticPlastic] {
-        let (mut start, mut params) = cloud_in(OPEN_BOX, 30.0);
-        for m in &mut start.materials {
-            m.rolling_friction = 0.05;
-            m.rolling_damping = 0.3;
-        }
-        params.round_law = talus::engine::RoundLaw::HertzMindlin { rolling };
-        let run = parity(host(64), &start, &params, 1000, false);
-        eprintln!(
-            "{rolling:?}: {} wall contacts, {} contacts at most",
-            run.most_wall_contacts, run.most_contacts
-        );
-        assert!(
-            run.most_wall_contacts > 100 && run.most_contacts > 100,
-            "{} wall contacts, {} contacts at most",
-            run.most_wall_contacts,
-            run.most_contacts
-        );
-    }
 }
 
 /// A sphere wedged in a box narrower than itself touches its floor and four sides:
