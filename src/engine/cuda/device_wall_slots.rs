@@ -1,6 +1,7 @@
 //! The particles' wall contacts on a device, [`SLOTS`] a particle: each contact's
 //! key (the wall and its plane's four rounded numbers), its tangential history (a
-//! friction spring, and for the volume law its twist), and its record for the
+//! friction spring, the twist beside the volume law, a rolling spring with rolling
+//! resistance), and its record for the
 //! walls' sums (`WALL_RECORD_DOUBLES` of `kernels/triangle.cuh`), for this
 //! evaluation and the one before, whose springs this one's contacts take up by key
 //! and whose contacts not taken up let their springs' energy go.
@@ -77,8 +78,8 @@ pub(super) fn too_many_wall_contacts() -> DeviceError {
 ///
 /// # Invariant
 /// Both sets hold [`SLOTS`] contacts for each of the same particles, each
-/// history `width` doubles: the spring (3), the stiffness it was stretched at, and
-/// where `width` is 5 the twist.
+/// history `width` doubles: the spring (3), the stiffness it was stretched at,
+/// where `width` is 5 or 8 the twist, where 8 the rolling spring (3).
 #[derive(Debug, Default)]
 pub struct WallSlots {
     width: usize,
@@ -91,7 +92,7 @@ pub struct WallSlots {
 
 impl WallSlots {
     /// Slots for `n` particles, each without contacts, histories of `width`
-    /// doubles (4: Hertz–Mindlin; 5: the volume law).
+    /// doubles (see [`history_row`]).
     pub fn new(device: &mut dyn Device, n: usize, width: usize) -> Result<Self, DeviceError> {
         let mut slots = WallSlots {
             width,

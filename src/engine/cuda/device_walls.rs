@@ -1,8 +1,8 @@
 //! The walls of a world on a device: their facets as placed in the world
 //! ([`PlacedWalls`]), each particle's contacts with them and their tangential
-//! history ([`WallSlots`]), and the walls' forces. A sphere's contacts are
-//! Hertz–Mindlin's (`kernels/walls.cu`), a polyhedron's the volume law's of its
-//! patches (`kernels/polyhedra.cu`, `device_wall_patches.rs`).
+//! history ([`WallSlots`]), and the walls' forces. A sphere's contacts follow
+//! Hertz–Mindlin or the volume law (`kernels/walls.cu`), a polyhedron's the volume
+//! law, patch by patch (`kernels/polyhedra.cu`, `device_wall_patches.rs`).
 //!
 //! The walls move on the host, by the CPU backend's own stage (their motions are
 //! prescribed or set from outside, a few numbers a step): a copy of the world
@@ -69,8 +69,8 @@ pub(super) struct DeviceWalls {
 
 impl DeviceWalls {
     /// The walls of `world`, placed and uploaded, for `n` particles whose contacts
-    /// keep histories of `width` doubles (4 where every particle is a sphere under
-    /// Hertz–Mindlin, else 5: the twist).
+    /// keep histories of `width` doubles (`DeviceBodyTypes::history_width`: 4, 5
+    /// with the twist, 8 with a rolling spring).
     pub fn new(
         device: &mut dyn Device,
         world: &World,
