@@ -21,7 +21,7 @@ use crate::engine::cpu::reference::pair_contact;
 use crate::engine::cuda::device::HostDevice;
 use crate::engine::laws::ContactLaws;
 use crate::engine::params::{REGULARISATION_LENGTH, RoundLaw};
-use crate::geometry::{Shape, generators};
+use crate::geometry::{Shape, Sphere, generators};
 use crate::world::World;
 use crate::world::{BodyType, Wall};
 
@@ -58,8 +58,9 @@ fn material(young: Real, restitution: Real, friction: Real) -> Material {
 }
 
 /// Pellets of about 5 mm in two materials, isotropic (dodecahedron) and not
-/// (cuboid, prism, random hulls); `pairs` pairs of particles at random poses and
-/// velocities, from apart to a fifth of a radius deep, most holding a friction
+/// (cuboid, prism, random hulls), and beads of two sizes; `pairs` pairs of
+/// particles at random poses and velocities, from apart to a fifth of a radius
+/// deep (a bead's centre inside a pellet at the deepest), most holding a friction
 /// spring and a twist.
 fn world_of_pairs(pairs: usize, random: &mut Pcg64) -> (World, Vec<TangentialHistory>) {
     let mut world = World {
@@ -80,6 +81,10 @@ fn world_of_pairs(pairs: usize, random: &mut Pcg64) -> (World, Vec<TangentialHis
         world
             .body_types
             .push(BodyType::new(shape, &world.materials[m], m));
+    }
+    for (m, radius) in [r, 0.6 * r].into_iter().enumerate() {
+        let shape = Shape::Sphere(Sphere { radius });
+        (world.body_types).push(BodyType::new(shape, &world.materials[m], m));
     }
     let types = world.body_types.len();
     let mut histories = Vec::new();
@@ -137,6 +142,12 @@ fn volume_contacts_equal_the_cpu_pair_stage() {
     let results = contacts.results(&device).unwrap();
     let kept = contacts.histories(&device).unwrap();
     let (mut touching, mut worst) = (0, [0.0 as Real; 4]);
+    // Touching pairs of two spheres, a sphere and a pellet, two pellets.
+    let mut kinds = [0; 3];
+    let sphere = |i: u32| {
+        let t = world.particles.body_type[i as usize] as usize;
+        usize::from(world.body_types[t].shape.as_sphere().is_some())
+    };
     for (k, &(i, j)) in list.iter().enumerate() {
         let result = pair_contact(&world, i as usize, j as usize, &histories[k], &laws, dt);
         let history = result.history;
@@ -149,6 +160,7 @@ fn volume_contacts_equal_the_cpu_pair_stage() {
             continue;
         }
         touching += 1;
+        kinds[2 - sphere(i) - sphere(j)] += 1;
         // Differences relative to the contact's own figures.
         let relative =
             |a: Real, b: Real, scale: Real| (a - b).abs() / scale.max(Real::MIN_POSITIVE);
@@ -199,11 +211,13 @@ fn volume_contacts_equal_the_cpu_pair_stage() {
         );
     }
     eprintln!(
-        "{touching} of {pairs} pairs touch; largest relative differences: force {:.1e}, \
-         torques {:.1e}, energies {:.1e}, history {:.1e}",
+        "{touching} of {pairs} pairs touch (beads, a bead on a pellet, pellets: {kinds:?}); \
+         largest relative differences: force {:.1e}, torques {:.1e}, energies {:.1e}, history \
+         {:.1e}",
         worst[0], worst[1], worst[2], worst[3]
     );
     assert!((600..1400).contains(&touching), "{touching}");
+    assert!(kinds.iter().all(|&k| k > 40), "{kinds:?}");
 }
 
 /// A floor of 2 cm squares, two triangles each, and a side wall of two triangles
@@ -250,6 +264,8 @@ const SIDE: Real = 0.03;
 /// against the side wall, at heights from touching to half a radius deep.
 fn pellets_on_walls(random: &mut Pcg64) -> World {
     let (mut world, _) = world_of_pairs(0, random);
+    // The pellets alone (the beads come after them).
+    (world.body_types).retain(|t| t.shape.as_polyhedron().is_some());
     world.walls = floor_and_side();
     let types = world.body_types.len() as u32;
     for k in 0..600 {
