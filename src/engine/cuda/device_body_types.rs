@@ -44,13 +44,8 @@ pub struct DeviceBodyTypes {
     pub(super) shape: Array<u32>,
     /// The spheres' Hertz–Mindlin table.
     pub(super) hertz: HertzTypes,
-    /// Whether a body type is a polyhedron.
-    pub(super) polyhedra: bool,
-    /// Whether spheres follow the volume law (else Hertz–Mindlin).
-    pub(super) round_volume: bool,
-    /// The spheres' rolling resistance under Hertz–Mindlin (`ROLLING_*` of
-    /// contact.cuh).
-    pub(super) rolling: u32,
+    /// The law of the spheres' contacts.
+    round: RoundLaw,
     mass: Array<Real>,
     /// Principal moments, three per type.
     inertia: Array<Real>,
@@ -80,17 +75,43 @@ impl DeviceBodyTypes {
         ]
     }
 
+    /// Whether spheres follow the volume law (else Hertz–Mindlin), as the kernels'
+    /// `round_volume` reads it.
+    pub(super) fn round_volume(&self) -> u32 {
+        u32::from(self.round == RoundLaw::Volume)
+    }
+
+    /// The spheres' rolling resistance under Hertz–Mindlin (`ROLLING_*` of
+    /// contact.cuh).
+    pub(super) fn rolling(&self) -> u32 {
+        match self.round {
+            RoundLaw::Volume
+            | RoundLaw::HertzMindlin {
+                rolling: RollingModel::None,
+            } => 0,
+            RoundLaw::HertzMindlin {
+                rolling: RollingModel::ConstantTorque,
+            } => 1,
+            RoundLaw::HertzMindlin {
+                rolling: RollingModel::ElasticPlastic,
+            } => 2,
+        }
+    }
+
     /// Whether every contact is a sphere's under Hertz–Mindlin without rolling
     /// resistance (`sphere_contacts` steps the pairs).
     pub(super) fn spheres_under_hertz(&self) -> bool {
-        !self.polyhedra && !self.round_volume && self.rolling == 0
+        let hertz = RoundLaw::HertzMindlin {
+            rolling: RollingModel::None,
+        };
+        self.shapes.is_empty() && self.round == hertz
     }
 
     /// Doubles of a contact's tangential history: the spring and its stiffness
     /// (4: spheres under Hertz–Mindlin alone), the twist (5), and with rolling
     /// resistance the rolling spring (8).
     pub(super) fn history_width(&self) -> usize {
-        if self.rolling != 0 {
+        if self.rolling() != 0 {
             ROLLING_HISTORY
         } else if self.spheres_under_hertz() {
             SPRING
@@ -166,16 +187,7 @@ impl DeviceBodyTypes {
             MATERIAL_LAW * laws.material_count().pow(2)
         );
         let mut uploaded = DeviceBodyTypes {
-            polyhedra: !distinct.is_empty(),
-            round_volume: round == RoundLaw::Volume,
-            rolling: match round {
-                RoundLaw::HertzMindlin { rolling } => match rolling {
-                    RollingModel::None => 0,
-                    RollingModel::ConstantTorque => 1,
-                    RollingModel::ElasticPlastic => 2,
-                },
-                RoundLaw::Volume => 0,
-            },
+            round,
             shapes: DeviceShapes::upload(device, &distinct)?,
             hertz: HertzTypes::upload(device, world)?,
             material_count: laws.material_count() as u32,

@@ -80,9 +80,9 @@ pub(super) unsafe fn pair_contacts(
     args.extend(types.shapes.args());
     args.extend(types.hertz.args());
     args.extend([
-        Arg::U32(u32::from(types.round_volume)),
+        Arg::U32(types.round_volume()),
         Arg::U32(types.history_width() as u32),
-        Arg::U32(types.rolling),
+        Arg::U32(types.rolling()),
         out.history.arg(),
         out.results.arg(),
         out.energies.arg(),

@@ -82,16 +82,23 @@ struct HostShapes {
     circumradius: Vec<Real>,
 }
 
+/// The vertex and face counts of `shape` where either is beyond the kernels' bit
+/// masks ([`MAX_SHAPE_PARTS`]).
+pub fn beyond_masks(shape: &ConvexPolyhedron) -> Option<(usize, usize)> {
+    let (vertices, faces) = (shape.vertices().len(), shape.face_count());
+    (vertices > MAX_SHAPE_PARTS || faces > MAX_SHAPE_PARTS).then_some((vertices, faces))
+}
+
 impl HostShapes {
     fn push(&mut self, index: usize, shape: &ConvexPolyhedron) -> Result<(), ShapeTableError> {
-        let (vertices, faces) = (shape.vertices().len(), shape.face_count());
-        if vertices > MAX_SHAPE_PARTS || faces > MAX_SHAPE_PARTS {
+        if let Some((vertices, faces)) = beyond_masks(shape) {
             return Err(ShapeTableError::TooLarge {
                 index,
                 vertices,
                 faces,
             });
         }
+        let (vertices, faces) = (shape.vertices().len(), shape.face_count());
         let word = |n: usize| n as u32;
         self.index.extend([
             word(self.vertices.len() / 3),

@@ -51,16 +51,6 @@ impl PlacedWalls {
         Ok(placed)
     }
 
-    /// The number of walls.
-    pub fn len(&self) -> usize {
-        self.placed.len()
-    }
-
-    /// Whether there are none.
-    pub fn is_empty(&self) -> bool {
-        self.placed.is_empty()
-    }
-
     /// The number of walls as a launch argument.
     pub(super) fn count_arg(&self) -> Arg {
         Arg::U32(self.placed.len() as u32)

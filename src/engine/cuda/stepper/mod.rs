@@ -41,7 +41,7 @@ use super::device::{Arg, Array, Device, DeviceError};
 use super::device_body_types::DeviceBodyTypes;
 use super::device_list::{DeviceList, ListInputs, run};
 use super::device_pair_contacts::{PairOutputs, pair_contacts};
-use super::device_polyhedra::{MAX_SHAPE_PARTS, ShapeTableError};
+use super::device_polyhedra::{MAX_SHAPE_PARTS, ShapeTableError, beyond_masks};
 use super::device_states::{StateView, roles};
 use super::device_sums::{PairTerms, RowSums, sum_energies};
 use super::device_wall_patches::Loads;
@@ -263,11 +263,8 @@ impl DeviceWorld {
             return unsupported("a fluid");
         }
         for (t, body) in world.body_types.iter().enumerate() {
-            let Some(p) = body.shape.as_polyhedron() else {
-                continue;
-            };
-            let (vertices, faces) = (p.vertices().len(), p.face_count());
-            if vertices > MAX_SHAPE_PARTS || faces > MAX_SHAPE_PARTS {
+            let parts = body.shape.as_polyhedron().and_then(beyond_masks);
+            if let Some((vertices, faces)) = parts {
                 return unsupported(&format!(
                     "body type {t}, a polyhedron of {vertices} vertices and {faces} faces (at \
                      most {MAX_SHAPE_PARTS} of each)"
