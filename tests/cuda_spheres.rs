@@ -316,15 +316,29 @@ fn a_cloud_thrown_into_a_box_steps_as_the_cpu_backend_to_the_bit() {
 
 fn thrown_into_a_box(device: Box<dyn Device>) {
     let (start, params) = cloud_in(OPEN_BOX, 30.0);
-    let run = parity(device, &start, &params, 1000, false);
-    assert!(
-        run.most_wall_contacts > 100,
-        "{} wall contacts at most",
-        run.most_wall_contacts
+    thrown(device, &start, &params, "thrown", 100, 100);
+}
+
+/// 1000 steps of the cloud `start` thrown into the box under `params` (`parity`),
+/// with more than `walls` wall contacts and `contacts` contacts at some hundredth
+/// step.
+fn thrown(
+    device: Box<dyn Device>,
+    start: &World,
+    params: &StepParams,
+    name: &str,
+    walls: usize,
+    contacts: usize,
+) {
+    let run = parity(device, start, params, 1000, false);
+    eprintln!(
+        "{name}: {} wall contacts, {} contacts at most",
+        run.most_wall_contacts, run.most_contacts
     );
     assert!(
-        run.most_contacts > 100,
-        "{} contacts at most",
+        run.most_wall_contacts > walls && run.most_contacts > contacts,
+        "{} wall contacts, {} contacts at most",
+        run.most_wall_contacts,
         run.most_contacts
     );
 }
@@ -358,17 +372,7 @@ fn converging_under_the_volume_law(device: Box<dyn Device>) {
 
 fn thrown_under_the_volume_law(device: Box<dyn Device>) {
     let (start, params) = under_the_volume_law(cloud_in(OPEN_BOX, 30.0));
-    let run = parity(device, &start, &params, 1000, false);
-    eprintln!(
-        "thrown: {} wall contacts, {} contacts at most",
-        run.most_wall_contacts, run.most_contacts
-    );
-    assert!(
-        run.most_wall_contacts > 40 && run.most_contacts > 60,
-        "{} wall contacts, {} contacts at most",
-        run.most_wall_contacts,
-        run.most_contacts
-    );
+    thrown(device, &start, &params, "thrown, volume law", 40, 60);
 }
 
 /// The cloud thrown into the box with rolling resistance under Hertz–Mindlin
@@ -396,17 +400,7 @@ fn thrown_with_rolling(device: Box<dyn Device>, rolling: talus::contact::Rolling
         m.rolling_damping = 0.3;
     }
     params.round_law = talus::engine::RoundLaw::HertzMindlin { rolling };
-    let run = parity(device, &start, &params, 1000, false);
-    eprintln!(
-        "{rolling:?}: {} wall contacts, {} contacts at most",
-        run.most_wall_contacts, run.most_contacts
-    );
-    assert!(
-        run.most_wall_contacts > 100 && run.most_contacts > 100,
-        "{} wall contacts, {} contacts at most",
-        run.most_wall_contacts,
-        run.most_contacts
-    );
+    thrown(device, &start, &params, &format!("{rolling:?}"), 100, 100);
 }
 
 /// A drum turning at 3 rad/s about a horizontal axis, its end plates attached to
