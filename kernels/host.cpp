@@ -18,6 +18,7 @@ thread_local dim3 threadIdx, blockIdx, blockDim, gridDim;
 #include "round_geometry.cuh"
 #include "volume_law.cuh"
 #include "facet.cuh"
+#include "facet_grid.cuh"
 #include "wall_patches.cuh"
 
 #include "integrate.cu"

@@ -7,7 +7,8 @@
 // (wall_patches.cuh); `polyhedron_wall_contacts`, one thread per particle, the
 // volume law's contact of each patch; `polyhedron_wall_sum_rows`, what they push on
 // the walls and their facets. Compiled after vec.cuh, contact.cuh, body.cuh,
-// triangle.cuh, overlap.cuh, volume_law.cuh, facet.cuh and wall_patches.cuh.
+// triangle.cuh, overlap.cuh, volume_law.cuh, facet.cuh, facet_grid.cuh and
+// wall_patches.cuh.
 
 // A pose of B in A's frame: B's centroid (three doubles), then its orientation
 // (w, x, y, z).
@@ -58,16 +59,18 @@ extern "C" __global__ void polyhedron_facets(
 // One thread per particle: its patches against every wall, in wall order, each
 // with its facets' shares (wall_patches.cuh; the facets as index within their
 // wall); none for a sphere, nor for a particle nobody here moves (frozen or a
-// ghost). `overflow` is
-// set where a particle has more patches than WALL_SLOTS or a patch more facets
-// than SHARE_SLOTS. Per wall, its first facet (walls + 1 entries); per facet, its
-// triangle in world coordinates and its unit normal.
+// ghost). `overflow` is set where a particle has more patches than WALL_SLOTS or
+// a patch more facets than SHARE_SLOTS. Per wall, its first facet (walls + 1
+// entries); per facet, its triangle in world coordinates and its unit normal;
+// the walls' facet grids (facet_grid.cuh).
 extern "C" __global__ void polyhedron_wall_patches(
     unsigned n, const double* position, const double* orientation, const unsigned* body_type,
     const unsigned char* role, const unsigned* type_shape, const unsigned* shape_index, const unsigned* face_span,
     const unsigned* loops, const Mask* face_masks, const double* vertices, const double* planes,
     const double* circumradius, unsigned walls, const unsigned* wall_facets,
-    const double* facets, const double* facet_normals, unsigned* patch_count,
+    const double* facets, const double* facet_normals, const double* grid_frame,
+    const unsigned* grid_head, const unsigned* grid_starts, const unsigned* grid_entries,
+    unsigned* patch_count,
     unsigned* patch_wall, long long* patch_keys, double* patch_geometry,
     unsigned* patch_shares, unsigned* share_facet, double* share_volume, unsigned* overflow) {
     unsigned i = blockIdx.x * blockDim.x + threadIdx.x;
@@ -86,13 +89,13 @@ extern "C" __global__ void polyhedron_wall_patches(
     place_body(table, shape, &side);
     Vec3 x = load3(position, i);
     Quat q = load_orientation(orientation, i);
+    FacetGrids grids = FacetGrids{grid_frame, grid_head, grid_starts, grid_entries};
     unsigned made = 0;
     for (unsigned w = 0; w < walls; ++w) {
         Patch patches[WALL_SLOTS];
         unsigned count = 0;
-        bool fits = wall_patches(table, &side, circumradius[shape], x, q, wall_facets[w],
-                                 wall_facets[w + 1], facets, facet_normals, &poly, patches,
-                                 &count);
+        bool fits = wall_patches(table, &side, circumradius[shape], x, q, grids, w,
+                                 wall_facets[w], facets, facet_normals, &poly, patches, &count);
         if (!fits || made + count > WALL_SLOTS) {
             atomicOr(overflow, 1u);
         }

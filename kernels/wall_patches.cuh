@@ -5,7 +5,7 @@
 // facet_geometry), summed by plane into patches whose prisms tile them, each with
 // its facets' shares (volumes). The CPU's operations in its order, the facets of
 // a wall in index order as the CPU's lists hold them. Compiled after vec.cuh,
-// triangle.cuh, overlap.cuh and facet.cuh.
+// triangle.cuh, overlap.cuh, facet.cuh and facet_grid.cuh.
 
 // Facets one patch's shares may name (a particle has at most WALL_SLOTS patches,
 // triangle.cuh).
@@ -45,16 +45,19 @@ static __device__ bool merge_into(Patch* p, unsigned f, double volume, double ar
 }
 
 // The patches of particle `side` (its shape placed in its body frame, bounding
-// radius `radius`, centroid `x`, orientation `q`) against the facets
-// `first..end` of one wall (world triangles, 9 doubles each, and unit normals),
-// into `patches` (`*count` of them, at most WALL_SLOTS); false where they do not
-// fit.
+// radius `radius`, centroid `x`, orientation `q`) against the facets of wall `w`
+// near it (facet_grid.cuh; the wall's facets from `first` in `facets`, world
+// triangles of 9 doubles each, and `facet_normals`, unit normals), into `patches`
+// (`*count` of them, at most WALL_SLOTS); false where they do not fit.
 static __device__ bool wall_patches(const ShapeTable& table, const Side* side, double radius,
-                                    Vec3 x, Quat q, unsigned first, unsigned end,
-                                    const double* facets, const double* facet_normals,
-                                    Polygon* poly, Patch* patches, unsigned* count) {
+                                    Vec3 x, Quat q, const FacetGrids& grids, unsigned w,
+                                    unsigned first, const double* facets,
+                                    const double* facet_normals, Polygon* poly, Patch* patches,
+                                    unsigned* count) {
     Quat back = conjugate(q);
-    for (unsigned f = first; f < end; ++f) {
+    FacetQuery near = facet_query(grids, w, x, radius);
+    for (unsigned j = next_facet(&near, 0); j != NO_FACET; j = next_facet(&near, j + 1)) {
+        unsigned f = first + j;
         const double* t = facets + 9 * f;
         Vec3 n = load3(facet_normals, f);
         double height = dot(n, sub(x, load3(t, 0)));

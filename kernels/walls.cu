@@ -1,8 +1,7 @@
 // The contacts of spheres with wall facets, under Hertz–Mindlin or the volume law
 // (engine/cpu/walls.rs, engine/cpu/patch.rs, geometry/sphere.rs): one thread per
-// particle, every wall's facets tested (no facet list yet: O(particles × facets)),
-// the facets of one plane merged into one contact at the deepest, the contacts
-// added to the
+// particle, the facets near it of every wall (facet_grid.cuh), the facets of one
+// plane merged into one contact at the deepest, the contacts added to the
 // particle's force and torque in wall and patch order after the pairs' gather:
 // the CPU backend's operations in its order, so the same bits. Then the walls'
 // forces, torques and facet forces, and the contacts' energies, as rows and
@@ -10,8 +9,8 @@
 //
 // Layouts: facets of all walls one after the other, wall w's from
 // wall_facets[w] to wall_facets[w + 1]: placed corners (9 doubles) and unit
-// normals (3). Per wall: its material, and velocity, angular velocity and
-// reference point (9 doubles). Per particle WALL_SLOTS contacts: the key (wall,
+// normals (3), and the walls' facet grids (facet_grid.cuh). Per wall: its
+// material, and velocity, angular velocity and reference point (9 doubles). Per particle WALL_SLOTS contacts: the key (wall,
 // and the plane's four rounded numbers: 5 long longs), the friction spring (4
 // doubles), and for the sums the force, the torque, the facet's share, the
 // elastic energy and the energy dissipated (9 doubles) and the facet; the count of
@@ -65,12 +64,14 @@ extern "C" __global__ void sphere_walls(
     const unsigned char* role, const unsigned char* type_sphere, const double* type_radius,
     const double* type_mass, const double* type_inertia, const double* type_rolling_inertia,
     const unsigned* type_material, unsigned materials, const double* material_pairs,
-    unsigned round_volume, unsigned rolling_model, const double* type_law, const double* material_law, unsigned walls, const unsigned* wall_facets,
-    const double* facets, const double* facet_normals, const unsigned* wall_material,
-    const double* wall_motion, unsigned history_doubles, const unsigned* old_count,
-    const long long* old_keys, const double* old_springs, unsigned* count, long long* keys,
-    double* springs, double* records, unsigned* record_facet, double* force, double* torque,
-    unsigned char* touching, unsigned* overflow) {
+    unsigned round_volume, unsigned rolling_model, const double* type_law,
+    const double* material_law, unsigned walls, const unsigned* wall_facets,
+    const double* facets, const double* facet_normals, const double* grid_frame,
+    const unsigned* grid_head, const unsigned* grid_starts, const unsigned* grid_entries,
+    const unsigned* wall_material, const double* wall_motion, unsigned history_doubles,
+    const unsigned* old_count, const long long* old_keys, const double* old_springs,
+    unsigned* count, long long* keys, double* springs, double* records, unsigned* record_facet,
+    double* force, double* torque, unsigned char* touching, unsigned* overflow) {
     unsigned i = blockIdx.x * blockDim.x + threadIdx.x;
     if (i >= n || !type_sphere[body_type[i]]) {
         return;
@@ -88,6 +89,7 @@ extern "C" __global__ void sphere_walls(
     // World::angular_velocity of an isotropic body: L / I.
     Vec3 spin = angular_velocity(q, l, inertia, true);
     Vec3 f = load3(force, i), t = load3(torque, i);
+    FacetGrids grids = FacetGrids{grid_frame, grid_head, grid_starts, grid_entries};
     unsigned made = 0;
     for (unsigned w = 0; w < walls; ++w) {
         // The patches of this wall: key, the deepest facet's contact, its facet and
@@ -97,7 +99,9 @@ extern "C" __global__ void sphere_walls(
         unsigned patch_facet[WALL_SLOTS];
         double patch_share[WALL_SLOTS];
         unsigned patches = 0;
-        for (unsigned k = wall_facets[w]; k < wall_facets[w + 1]; ++k) {
+        FacetQuery near = facet_query(grids, w, x, r);
+        for (unsigned j = next_facet(&near, 0); j != NO_FACET; j = next_facet(&near, j + 1)) {
+            unsigned k = wall_facets[w] + j;
             const double* tri = facets + 9 * k;
             Vec3 nrm = load3(facet_normals, k);
             double height = dot(nrm, sub(x, load3(tri, 0)));

@@ -215,6 +215,32 @@ impl FacetGrid {
         grid
     }
 
+    /// The grid's lowest corner, in the wall frame.
+    pub fn origin(&self) -> Vector3<Real> {
+        self.origin
+    }
+
+    /// The cells' edge.
+    pub fn cell(&self) -> Real {
+        self.cell
+    }
+
+    /// The cells along x, y and z (none for a wall without facets).
+    pub fn dims(&self) -> [usize; 3] {
+        self.dims
+    }
+
+    /// Per cell (x fastest, then y, then z) where its facets begin in
+    /// [`Self::entries`], and last their count (empty for a wall without facets).
+    pub fn cell_starts(&self) -> &[u32] {
+        &self.starts
+    }
+
+    /// The cells' facets, each cell's ascending.
+    pub fn entries(&self) -> &[u32] {
+        &self.facets
+    }
+
     fn coords(&self, p: &Vector3<Real>) -> [usize; 3] {
         let mut c = [0; 3];
         for k in 0..3 {

@@ -118,11 +118,9 @@ impl DeviceWallPatches {
             types.shape.arg(),
         ];
         args.extend(types.shapes.args());
+        args.extend([walls.count_arg(), walls.wall_facets.arg()]);
+        args.extend(walls.facet_args());
         args.extend([
-            walls.count_arg(),
-            walls.wall_facets.arg(),
-            walls.facets.arg(),
-            walls.normals.arg(),
             self.count.arg(),
             self.wall.arg(),
             self.keys.arg(),

@@ -1,11 +1,12 @@
 //! The walls as the device's wall kernels read them (`kernels/walls.cu`,
 //! `kernels/polyhedra.cu`): every wall's facets placed in the world, one wall's
-//! after the other's, with their unit normals, and per wall its material and
-//! motion.
+//! after the other's, with their unit normals, the walls' facet grids, and per
+//! wall its material and motion.
 
 use nalgebra::Isometry3;
 
 use super::device::{Arg, Array, Device, DeviceError};
+use super::device_facet_grids::DeviceFacetGrids;
 use crate::Real;
 use crate::geometry::wall::facet_normal;
 use crate::world::Wall;
@@ -16,7 +17,8 @@ use crate::world::Wall;
 /// `wall_facets` holds each wall's first facet and, last, the facet count; `facets`
 /// and `normals` hold the facets of the walls as they stood at the poses in
 /// `placed` (corners, 9 doubles, and unit normals, 3, by the CPU backend's
-/// operations); `motion` the walls' velocities, angular velocities and reference
+/// operations), and `grids` the walls' facet grids placed at the same poses;
+/// `motion` the walls' velocities, angular velocities and reference
 /// points as last updated.
 #[derive(Debug, Default)]
 pub struct PlacedWalls {
@@ -25,6 +27,7 @@ pub struct PlacedWalls {
     pub(super) wall_facets: Array<u32>,
     pub(super) facets: Array<Real>,
     pub(super) normals: Array<Real>,
+    pub(super) grids: DeviceFacetGrids,
     pub(super) material: Array<u32>,
     /// Per wall: velocity, angular velocity, reference point (9 doubles).
     pub(super) motion: Array<Real>,
@@ -40,6 +43,7 @@ impl PlacedWalls {
         let facets = starts[walls.len()] as usize;
         let mut placed = PlacedWalls {
             placed: vec![None; walls.len()],
+            grids: DeviceFacetGrids::new(device, walls)?,
             ..Default::default()
         };
         placed.wall_facets.write(device, &starts)?;
@@ -51,18 +55,35 @@ impl PlacedWalls {
         Ok(placed)
     }
 
+    /// The placed facets as launch arguments: corners, normals and the grids'
+    /// four arrays (`facets`, `facet_normals`, `grid_*` of the wall kernels).
+    pub(super) fn facet_args(&self) -> impl Iterator<Item = Arg> + '_ {
+        [self.facets.arg(), self.normals.arg()]
+            .into_iter()
+            .chain(self.grids.args())
+    }
+
+    /// Bytes of device memory held.
+    pub fn bytes(&self, device: &dyn Device) -> usize {
+        let doubles = [&self.facets, &self.normals, &self.motion];
+        let words = [&self.wall_facets, &self.material];
+        doubles.iter().map(|a| a.bytes(device)).sum::<usize>()
+            + words.iter().map(|a| a.bytes(device)).sum::<usize>()
+            + self.grids.bytes(device)
+    }
+
     /// The number of walls as a launch argument.
     pub(super) fn count_arg(&self) -> Arg {
         Arg::U32(self.placed.len() as u32)
     }
 
-    /// Places again the facets of every wall whose pose changed (the same walls
-    /// as at [`Self::new`], moved) and uploads them, and every wall's velocities
-    /// and reference point.
+    /// Places again the facets and the grid of every wall whose pose changed (the
+    /// same walls as at [`Self::new`], moved) and uploads them, and every wall's
+    /// velocities and reference point.
     pub fn update(&mut self, device: &mut dyn Device, walls: &[Wall]) -> Result<(), DeviceError> {
         let mut motion = Vec::with_capacity(9 * walls.len());
         let mut first = 0;
-        for (wall, placed) in walls.iter().zip(&mut self.placed) {
+        for (w, (wall, placed)) in walls.iter().zip(&mut self.placed).enumerate() {
             motion.extend(wall.velocity.iter().chain(&wall.angular_velocity));
             motion.extend(wall.reference().coords.iter());
             let facets = wall.triangles.len();
@@ -76,6 +97,7 @@ impl PlacedWalls {
                 }
                 self.facets.write_at(device, 9 * first, &corners)?;
                 self.normals.write_at(device, 3 * first, &normals)?;
+                self.grids.place(device, w, wall)?;
             }
             first += facets;
         }

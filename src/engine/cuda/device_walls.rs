@@ -108,11 +108,7 @@ impl DeviceWalls {
     /// Bytes of device memory the walls hold: their facets and, per particle,
     /// [`super::device_wall_slots::SLOTS`] contacts (and polyhedra's patches).
     pub fn bytes(&self, device: &dyn Device) -> usize {
-        let p = &self.placed;
-        let doubles = [&p.facets, &p.normals, &p.motion];
-        let words = [&p.wall_facets, &p.material];
-        doubles.iter().map(|a| a.bytes(device)).sum::<usize>()
-            + words.iter().map(|a| a.bytes(device)).sum::<usize>()
+        self.placed.bytes(device)
             + self.slots.bytes(device)
             + self.patches.as_ref().map_or(0, |p| p.bytes(device))
             + self.sums.bytes(device)
@@ -244,12 +240,13 @@ impl DeviceWalls {
             at.laws.material_law.arg(),
             w.count_arg(),
             w.wall_facets.arg(),
-            w.facets.arg(),
-            w.normals.arg(),
+        ];
+        args.extend(w.facet_args());
+        args.extend([
             w.material.arg(),
             w.motion.arg(),
             Arg::U32(self.slots.width() as u32),
-        ];
+        ]);
         args.extend(self.slots.args());
         args.extend([
             at.loads.force.arg(),

@@ -7,15 +7,19 @@
 //! A [`device::Device`] holds buffers and launches kernels: the CUDA driver
 //! ([`driver::CudaDevice`]) or the host executor ([`device::HostDevice`]), behind
 //! one interface, so the code that drives the kernels is the same on both.
-//! [`stepper::DeviceWorld`] steps a world of Hertz–Mindlin spheres and walls on a
-//! device: integration, the candidate list (a hashed cell grid, pairs by prefix
-//! sum), the pair contacts with their tangential history, the gather, the wall
-//! contacts and the walls' sums; it gives the CPU backend's bits through the host
-//! executor. Polyhedra, the backend behind the seam and multi-GPU are to come.
+//! [`stepper::DeviceWorld`] steps a world of spheres, convex polyhedra or both,
+//! under every contact law of the CPU backend, with its walls, on a device:
+//! integration, the candidate list (a hashed cell grid, pairs by prefix sum), the
+//! pair contacts with their tangential history, the gather, the wall contacts
+//! (the facets near a particle found through each wall's facet grid) and the
+//! walls' sums. Through the host executor it gives the CPU backend's bits for
+//! spheres and agrees to round-off for polyhedra; [`backend`] puts it behind the
+//! backend seam, on one device per MPI rank.
 
 pub mod backend;
 pub mod device;
 pub mod device_body_types;
+mod device_facet_grids;
 mod device_hertz;
 mod device_list;
 pub mod device_pair_contacts;
@@ -102,6 +106,13 @@ pub static FACET: KernelFile = KernelFile {
     headers: &[],
 };
 
+/// The facets of a wall near a particle, through the wall's facet grid.
+pub static FACET_GRID: KernelFile = KernelFile {
+    name: "facet_grid.cuh",
+    source: include_str!("../../../kernels/facet_grid.cuh"),
+    headers: &[],
+};
+
 /// A polyhedron's facet overlaps summed into patches by plane.
 pub static WALL_PATCHES: KernelFile = KernelFile {
     name: "wall_patches.cuh",
@@ -134,7 +145,7 @@ pub static FILES: [KernelFile; 10] = [
     KernelFile {
         name: "walls.cu",
         source: include_str!("../../../kernels/walls.cu"),
-        headers: &[&VEC, &CONTACT, &BODY, &TRIANGLE, &VOLUME_LAW],
+        headers: &[&VEC, &CONTACT, &BODY, &TRIANGLE, &VOLUME_LAW, &FACET_GRID],
     },
     KernelFile {
         name: "sums.cu",
@@ -162,6 +173,7 @@ pub static FILES: [KernelFile; 10] = [
             &OVERLAP,
             &VOLUME_LAW,
             &FACET,
+            &FACET_GRID,
             &WALL_PATCHES,
         ],
     },
