@@ -30,6 +30,8 @@ echo "== tests (--features zenoh,mpi,cuda: everything; the MPI tests start mpiru
 cargo test --locked --all-targets --features zenoh,mpi,cuda
 echo "== benchmarks build"
 cargo bench --locked --no-run
+echo "== profile-guided build (scripts/build-pgo.sh: trained, rebuilt, the check pour's outputs unchanged)"
+scripts/build-pgo.sh
 echo "== the Python module: an abi3 wheel built by maturin, installed into .venv"
 rm -rf target/wheels
 .venv/bin/maturin build --locked -m python/Cargo.toml --profile dev --strip --out target/wheels

@@ -17,7 +17,10 @@ loop (LIGGGHTS's "Loop time", talus's summary.json), over the pour and the settl
 bed; the ratio talus / LIGGGHTS on one thread; talus's speed-up on two threads.
 
     benches/peers/liggghts_pour.py [--install] [--rounds 2] [--threads 1 2]
-                                   [--steps 50000] [--settled-steps 10000]
+                                   [--steps 50000] [--settled-steps 10000] [--pgo]
+
+--pgo also builds talus with scripts/build-pgo.sh (profile-guided) and measures
+that build beside the plain release build, interleaved in each round.
 
 --install installs the Debian package `liggghts` when it is missing (apt-get, as
 root). LIGGGHTS must never be run with `-screen none`: that build crashes with it.
@@ -131,6 +134,8 @@ def main() -> None:
     p.add_argument("--threads", type=int, nargs="+", default=[1, 2])
     p.add_argument("--steps", type=int, default=50000)
     p.add_argument("--settled-steps", type=int, default=10000)
+    p.add_argument("--pgo", action="store_true",
+                   help="also measure the profile-guided build of scripts/build-pgo.sh, interleaved")
     args = p.parse_args()
     if shutil.which("liggghts") is None:
         if not args.install:
@@ -138,39 +143,45 @@ def main() -> None:
         subprocess.run(["apt-get", "install", "-y", "liggghts"], check=True,
                        env=dict(os.environ, DEBIAN_FRONTEND="noninteractive"))
     subprocess.run(["cargo", "build", "--release", "--quiet"], cwd=ROOT, check=True)
-    binary = ROOT / "target" / "release" / "talus"
+    builds = {"talus": ROOT / "target" / "release" / "talus"}
+    if args.pgo:
+        subprocess.run([str(ROOT / "scripts" / "build-pgo.sh")], cwd=ROOT, check=True,
+                       stdout=subprocess.DEVNULL)
+        builds["talus pgo"] = ROOT / "target" / "pgo" / "talus"
     work = Path(tempfile.mkdtemp(prefix="talus-peers-"))
-    results = {"liggghts": []} | {f"talus {t}": [] for t in args.threads}
+    runs = [(f"{name} {t}", binary, t) for t in args.threads for name, binary in builds.items()]
+    results = {"liggghts": []} | {key: [] for key, _, _ in runs}
     contacts = {}
     for round_ in range(args.rounds):
         results["liggghts"].append(liggghts(work, args.steps, args.settled_steps))
         write_poses(last_frame(work / "start.dump"), work / "start.csv")
         write_poses(last_frame(work / "settled.dump"), work / "settled.csv")
-        for t in args.threads:
+        for key, binary, t in runs:
             pour = talus(binary, work, work / "start.csv", args.steps, t, "pour")
             settled = talus(binary, work, work / "settled.csv", args.settled_steps, t, "settled")
-            results[f"talus {t}"].append({"pour": pour["particle_steps_per_s"],
-                                          "settled": settled["particle_steps_per_s"]})
+            results[key].append({"pour": pour["particle_steps_per_s"],
+                                 "settled": settled["particle_steps_per_s"]})
             contacts = {"pour end": pour["contacts"], "settled": settled["contacts"]}
         print(f"round {round_ + 1}: " + json.dumps(results), file=sys.stderr)
     cpu = next((l.split(":", 1)[1].strip() for l in open("/proc/cpuinfo") if l.startswith("model name")), "?")
     print(f"machine: {cpu}, {os.cpu_count()} logical cores; {args.rounds} rounds interleaved")
     print(f"scene: 5000 spheres poured for {args.steps} steps of {DT} s, then {args.settled_steps} "
           f"steps of the settled bed; talus contacts at the end: {contacts}")
-    print(f"{'code':<12} {'pour particle-steps/s':>22} {'settled particle-steps/s':>25}")
+    print(f"{'code':<16} {'pour particle-steps/s':>22} {'settled particle-steps/s':>25}")
     median = {k: {s: statistics.median(r[s] for r in v) for s in ("pour", "settled")}
               for k, v in results.items()}
     for k, m in median.items():
-        print(f"{k:<12} {m['pour']:>22.3e} {m['settled']:>25.3e}")
+        print(f"{k:<16} {m['pour']:>22.3e} {m['settled']:>25.3e}")
     lig = median["liggghts"]
-    for t in args.threads:
-        m = median[f"talus {t}"]
-        print(f"talus on {t} thread(s) / LIGGGHTS on 1: pour {m['pour'] / lig['pour']:.2f}, "
-              f"settled {m['settled'] / lig['settled']:.2f}")
-    if 1 in args.threads and 2 in args.threads:
-        one, two = median["talus 1"], median["talus 2"]
-        print(f"talus 2 threads / 1 thread: pour {two['pour'] / one['pour']:.2f}, "
-              f"settled {two['settled'] / one['settled']:.2f}")
+    for name in builds:
+        for t in args.threads:
+            m = median[f"{name} {t}"]
+            print(f"{name} on {t} thread(s) / LIGGGHTS on 1: pour {m['pour'] / lig['pour']:.2f}, "
+                  f"settled {m['settled'] / lig['settled']:.2f}")
+        if 1 in args.threads and 2 in args.threads:
+            one, two = median[f"{name} 1"], median[f"{name} 2"]
+            print(f"{name} 2 threads / 1 thread: pour {two['pour'] / one['pour']:.2f}, "
+                  f"settled {two['settled'] / one['settled']:.2f}")
     shutil.rmtree(work, ignore_errors=True)
 
 
