@@ -4,7 +4,9 @@
 # (the sphere pour to rest, the dodecahedron bed, the sphere bed and the many
 # shapes, on one and two threads) and a short pour of beads onto dodecahedra,
 # merges the profiles with the toolchain's llvm-profdata (rustup's `llvm-tools`,
-# added when missing), and builds talus again with them. The result is
+# added when missing; where rustup cannot add it, Debian's llvm-N of the LLVM
+# major version rustc was built with, whose profile format is rustc's), and
+# builds talus again with them. The result is
 # target/pgo/talus; it must write what the instrumented build wrote for the
 # check pour (frames, series.csv, walls.csv byte for byte: profile guidance moves
 # code, never arithmetic), or the script fails.
@@ -16,7 +18,19 @@ host="$(rustc -vV | sed -n 's/^host: //p')"
 profdata="$(rustc --print sysroot)/lib/rustlib/$host/bin/llvm-profdata"
 if [ ! -x "$profdata" ]; then
     echo "== llvm-tools (llvm-profdata) for $(rustc --version)"
-    rustup component add llvm-tools
+    rustup component add llvm-tools || true
+fi
+if [ ! -x "$profdata" ]; then
+    major="$(rustc -vV | sed -n 's/^LLVM version: \([0-9]*\).*/\1/p')"
+    profdata="/usr/bin/llvm-profdata-$major"
+    if [ ! -x "$profdata" ]; then
+        echo "== Debian's llvm-$major (llvm-profdata)"
+        as_root=()
+        [ "$(id -u)" -eq 0 ] || as_root=(sudo)
+        "${as_root[@]}" apt-get update -qq
+        DEBIAN_FRONTEND=noninteractive "${as_root[@]}" apt-get install -y -qq \
+            --no-install-recommends "llvm-$major" >/dev/null
+    fi
 fi
 rm -rf "$work/profiles" "$work/check"
 mkdir -p "$work/check"
