@@ -28,6 +28,7 @@ use talus::engine::mpi_exchange;
 use talus::engine::rank::RankStepper;
 use talus::engine::{Backend, ContactHistory, CpuBackend};
 use talus::scene::{Scene, Simulation};
+use talus::world::Particles;
 
 /// Set in the environment of the copies that mpirun starts.
 const RANK_MARK: &str = "TALUS_MPI_RANK";
@@ -281,9 +282,7 @@ fn pour_on_ranks(exchange: Box<dyn Ranks>) -> usize {
         // One process stores its particles in the space order, the gathered world
         // by id: compared by id.
         let (a, b) = (&one.world().particles, &whole.particles);
-        assert_eq!(a.len(), b.len(), "step {step}");
-        for i in 0..a.len() {
-            let j = b.index_of(a.id[i]).expect("the same particles");
+        for (i, j) in by_id(a, b) {
             assert_eq!(a.position[i], b.position[j], "step {step}");
             assert_eq!(a.velocity[i], b.velocity[j], "step {step}");
             assert_eq!(a.angular_momentum[i], b.angular_momentum[j], "step {step}");
@@ -293,6 +292,13 @@ fn pour_on_ranks(exchange: Box<dyn Ranks>) -> usize {
     let inserted = one.world().particles.len() - scene.world.particles.len();
     assert_eq!(inserted, 120, "the inlet's particles");
     one.world().particles.len()
+}
+
+/// The entries of `a`'s particles, each with the entry of the same particle (by id)
+/// in `b`, which must hold the same particles.
+fn by_id<'a>(a: &'a Particles, b: &'a Particles) -> impl Iterator<Item = (usize, usize)> + 'a {
+    assert_eq!(a.len(), b.len(), "the same particles");
+    (0..a.len()).map(|i| (i, b.index_of(a.id[i]).expect("the same particles")))
 }
 
 /// A pour of cubes onto dodecahedra in a box (the scene of `tests/cuda_polyhedra.rs`).
@@ -330,9 +336,7 @@ fn rocks_on_ranks(exchange: Box<dyn Ranks>) -> String {
             continue;
         };
         let (a, b) = (&one.world().particles, &whole.particles);
-        assert_eq!(a.len(), b.len(), "step {step}");
-        for i in 0..a.len() {
-            let j = b.index_of(a.id[i]).expect("the same particles");
+        for (i, j) in by_id(a, b) {
             worst = worst.max((a.position[i] - b.position[j]).norm() / 0.005);
         }
         assert!(worst < 1e-8, "step {step}: {worst:e}");
