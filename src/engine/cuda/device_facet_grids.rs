@@ -14,8 +14,8 @@ const FRAME: usize = 11;
 /// The walls' facet grids on a device.
 ///
 /// # Invariant
-/// Per wall, `frame` holds the pose last given to [`Self::place`] and the grid's
-/// origin and cell; `head` its cells along each axis and where its cell starts and
+/// Per wall, `frame` holds the pose last given to [`Self::place`] (zeros until
+/// then) and the grid's origin and cell; `head` its cells along each axis and where its cell starts and
 /// entries begin in `starts` and `entries`, which hold each wall's
 /// [`FacetGrid::cell_starts`] and [`FacetGrid::entries`] one wall's after the other's.
 #[derive(Debug, Default)]
@@ -27,20 +27,19 @@ pub struct DeviceFacetGrids {
 }
 
 impl DeviceFacetGrids {
-    /// The grids of `walls`, at their poses now.
+    /// The grids of `walls`, each to be placed ([`Self::place`]) before a kernel
+    /// reads it.
     pub fn new(device: &mut dyn Device, walls: &[Wall]) -> Result<Self, DeviceError> {
         let (mut head, mut starts, mut entries) = (Vec::new(), Vec::new(), Vec::new());
-        let mut frame = Vec::with_capacity(FRAME * walls.len());
         for wall in walls {
             let grid = &wall.grid;
             head.extend(grid.dims().map(|d| d as u32));
             head.extend([starts.len() as u32, entries.len() as u32]);
             starts.extend_from_slice(grid.cell_starts());
             entries.extend_from_slice(grid.entries());
-            frame.extend(frame_row(wall));
         }
         let mut grids = DeviceFacetGrids::default();
-        grids.frame.write(device, &frame)?;
+        grids.frame.resize(device, FRAME * walls.len())?;
         grids.head.write(device, &head)?;
         grids.starts.write(device, &starts)?;
         grids.entries.write(device, &entries)?;
