@@ -45,7 +45,8 @@ pub enum Stage {
     NeighbourList,
     /// Particle-pair contacts (narrow phase and contact laws).
     PairContacts,
-    /// Each particle gathering its pairs' forces.
+    /// Adding to the particles the pairs that the parts of the pair sweep deferred
+    /// (the pairs of particles between two parts, on many threads).
     Gather,
     /// Particle–wall contacts and their accumulation on walls and facets.
     WallContacts,

@@ -2,8 +2,8 @@
 //! history of every candidate pair and wall patch, and the overlap decisions that
 //! only change the cost.
 
+use super::blocks::BLOCK;
 use super::overlap_plans::OverlapPlans;
-use super::pair_results::BLOCK;
 use super::wall_history::WallHistory;
 use crate::Real;
 use crate::contact::TangentialHistory;

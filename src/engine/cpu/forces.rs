@@ -37,15 +37,13 @@ impl ContactForce {
     }
 }
 
-/// What the gather reads of a pair: the force and the torque on each body and the
+/// What a pair adds to its particles: the force and the torque on each body and the
 /// energy its contact holds and dissipated, all zero when the pair does not touch
 /// (but for the energy of a friction spring let go as the pair parted).
 ///
-/// The contact's history is written beside its pair instead, so that the results
-/// array the pair stage writes and the gather reads stays small. The torque on body 1
-/// is taken here, where the pair's positions are at hand, and a pair apart adds
-/// zeros, so that the gather adds without a branch: its loads of scattered results
-/// then overlap instead of waiting on a mispredicted test each.
+/// The contact's history is written beside its pair instead, so that a result kept
+/// for later (a pair that a part of the sweep defers) stays small. The torque on
+/// body 1 is taken here, where the pair's positions are at hand.
 #[derive(Clone, Copy, Debug, Default)]
 pub(super) struct PairResult {
     /// Force on body 2; body 1 gets the opposite.

@@ -57,10 +57,12 @@ pub(super) fn round_contact_force(
     };
     let m = law.materials;
     let f = hertz_mindlin_force(&c, &m.hertz, m.friction, history, law.dt);
-    let mut torque = lever.cross(&f.force);
-    let mut resisting = Vector3::zeros();
-    let mut kept = f.history;
-    if law.rolling != RollingModel::None {
+    // The rolling torque and spring as two vectors from either path, not the whole
+    // history: a 64-byte history merged from two paths was copied through the stack.
+    let lever_torque = lever.cross(&f.force);
+    let (torque, resisting, spring) = if law.rolling == RollingModel::None {
+        (lever_torque, Vector3::zeros(), f.history.rolling)
+    } else {
         let contact = RollingContact {
             normal: *normal,
             relative_spin: motion.spin,
@@ -69,12 +71,19 @@ pub(super) fn round_contact_force(
             radius: law.radius,
             inertia: law.rolling_inertia,
         };
-        let (rolling, spring) =
-            rolling_torque(law.rolling, &m.rolling, &contact, &kept.rolling, law.dt);
-        torque += rolling;
-        resisting = rolling;
-        kept.rolling = spring;
-    }
+        let (rolling, spring) = rolling_torque(
+            law.rolling,
+            &m.rolling,
+            &contact,
+            &f.history.rolling,
+            law.dt,
+        );
+        (lever_torque + rolling, rolling, spring)
+    };
+    let kept = TangentialHistory {
+        rolling: spring,
+        ..f.history
+    };
     ContactForce {
         force: f.force,
         torque,
@@ -92,7 +101,7 @@ pub(super) fn round_contact_force(
 
 /// The contact of spheres `i` and `j` (body types `a` and `b`), if they overlap:
 /// the sphere pair's own path (see the module docs).
-#[inline]
+#[inline(always)]
 pub(super) fn sphere_pair(
     world: &World,
     (i, a): (usize, &SphereBody),

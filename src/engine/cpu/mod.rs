@@ -1,22 +1,25 @@
 //! The CPU backend (rayon): the reference implementation of [`Backend`].
 //!
 //! A step is kick and drift, the walls' prescribed motion, the force evaluation
-//! (contact laws, neighbour list, pair contacts, gather, wall contacts) and the
-//! closing kick: [`CpuBackend::step`] and [`CpuBackend::evaluate_forces`] list the
-//! stages in order, each a data-parallel loop over particles, pairs or particle
-//! chunks that writes its own slot, timed by [`StageTimes`]. Each particle gathers its
-//! pairs' forces in pair order (its partners in the order of their space keys) and wall
-//! contacts are added in particle order, so the results do not depend on the number
-//! of threads, and the particles' motion not on their order in the arrays (the
-//! walls' totals do, by round-off; `tests/memory_order.rs`).
+//! (contact laws, neighbour list, pair contacts, the deferred pairs' sums, wall
+//! contacts) and the closing kick: [`CpuBackend::step`] and
+//! [`CpuBackend::evaluate_forces`] list the stages in order, each a data-parallel
+//! loop over particles, parts of the pair list or particle chunks, timed by
+//! [`StageTimes`]. Each particle gets its pairs' forces in pair order (its partners
+//! in the order of their space keys) and wall contacts are added in particle order,
+//! so the results do not depend on the number of threads, and the particles' motion
+//! not on their order in the arrays (the walls' totals do, by round-off;
+//! `tests/memory_order.rs`).
 //!
-//! The parts: [`motion`] (integration stages), [`pairs`] (pair contacts and gather),
-//! [`fused`] (the two fused, on one thread),
+//! The parts: [`motion`] (integration stages), [`pairs`] (a pair's contact, a
+//! block's pairs), [`fused`] (the pair sweep in parts, each pair added to its
+//! particles as it is evaluated), [`blocks`] (blocks of pairs and their masks),
 //! [`walls`] (wall stage), [`dispatch`] (shape pair → contact geometry), [`patch`]
 //! (coplanar facets merged into one contact), [`relative_motion`] (how the bodies
 //! move at a contact), [`forces`] (geometry → force through the contact laws),
 //! [`contact_state`] (what persists between steps).
 
+mod blocks;
 mod contact_state;
 mod dispatch;
 mod fluid;
@@ -27,7 +30,6 @@ mod huge_pages;
 mod keep_awake;
 pub(crate) mod motion;
 mod overlap_plans;
-mod pair_results;
 mod pairs;
 mod patch;
 mod prefetch;
@@ -41,7 +43,6 @@ mod walls;
 use std::ops::Range;
 
 use self::contact_state::ContactState;
-use self::pair_results::PairResults;
 use self::type_table::TypeTable;
 use self::walls::{WallInputs, WallWork};
 use super::backend::{Backend, ContactHistory};
@@ -58,8 +59,8 @@ use crate::world::World;
 struct Workspace {
     /// Bounding radius of every particle.
     radii: Vec<Real>,
-    /// The pair results of a step on many threads.
-    results: PairResults,
+    /// The parts the pairs are swept in, with what they defer.
+    parts: fused::Parts,
     /// Whether each particle touched another or a wall at the last force evaluation.
     touching: Vec<bool>,
     walls: WallWork,
@@ -147,32 +148,19 @@ impl CpuBackend {
             round: params.round_law,
             dt,
         };
-        let totals = if fused::fused() {
-            times.time(Stage::PairContacts, || {
-                fused::pair_contacts_gathered(
-                    world,
-                    list,
-                    contacts,
-                    (&work.radii, types),
-                    pair_laws,
-                    &mut work.touching,
-                )
-            })
-        } else {
-            times.time(Stage::PairContacts, || {
-                pairs::pair_contacts(
-                    world,
-                    list,
-                    contacts,
-                    (&work.radii, types),
-                    pair_laws,
-                    &mut work.results,
-                )
-            });
-            times.time(Stage::Gather, || {
-                pairs::gather(world, list, &work.results, &mut work.touching)
-            })
-        };
+        let totals = times.time(Stage::PairContacts, || {
+            fused::pair_contacts_gathered(
+                world,
+                list,
+                contacts,
+                (&work.radii, types),
+                pair_laws,
+                (&mut work.touching, &mut work.parts),
+            )
+        });
+        let totals = times.time(Stage::Gather, || {
+            fused::add_deferred(world, list, (&mut work.touching, &work.parts), totals)
+        });
         let (pair_contacts, candidate_pairs) = (totals.contacts, totals.candidates);
         let totals = times.time(Stage::WallContacts, || {
             let inputs = WallInputs {

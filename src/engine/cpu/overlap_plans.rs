@@ -11,7 +11,7 @@
 
 use std::sync::atomic::{AtomicU64, Ordering};
 
-use super::pair_results::BLOCK;
+use super::blocks::BLOCK;
 use crate::geometry::overlap::OverlapCache;
 
 /// The plans of the list's pairs, and per block of [`BLOCK`] pairs a word whose bit

@@ -1,27 +1,21 @@
-//! The particle-pair stages: every candidate pair's contact, in parallel over the flat
-//! pair array, then every particle gathering its pairs' forces in pair order.
+//! A candidate pair's contact and a block's pairs evaluated in pair order: what the
+//! pair sweep ([`super::fused`]) adds to the particles.
 
 use nalgebra::Vector3;
-use rayon::prelude::*;
 
-use super::contact_state::{ContactState, held_mask};
+use super::blocks::{BLOCK, BusyBits};
+use super::contact_state::held_mask;
 use super::dispatch::pair_geometry;
 use super::forces::{ContactForce, PairResult, RelativeMotion, pair_force};
 use super::hertz::{HertzInputs, rolling_inertia, round_contact_force, round_radius, sphere_pair};
 use super::overlap_plans::record;
-use super::pair_results::{BLOCK, BusyBits, PairResults};
 use super::prefetch::PairPrefetch;
-use super::type_table::TypeTable;
 use crate::Real;
 use crate::contact::{RollingModel, TangentialHistory, effective_radius};
 use crate::engine::RoundLaw;
 use crate::engine::laws::ContactLaws;
-use crate::engine::neighbours::NeighbourList;
 use crate::geometry::overlap::OverlapCache;
 use crate::world::{BodyType, Particles, World};
-
-/// Smallest share of particles one rayon task takes.
-const PARTICLES_PER_TASK: usize = 256;
 
 /// The laws of the pair stage.
 #[derive(Clone, Copy, Debug)]
@@ -31,25 +25,33 @@ pub(super) struct PairLaws<'a> {
     pub dt: Real,
 }
 
-/// The contact of particles `i` and `j` whose bounding spheres overlap, under the
-/// scene's laws; `plan` is the pair's kept overlap plan.
-#[inline]
+/// The result of the contact of particles `i` and `j` whose bounding spheres overlap,
+/// under the scene's laws, if they touch, with `history` replaced by the one the
+/// contact leaves; `plan` is the pair's kept overlap plan.
+#[inline(always)]
 fn pair_contact(
     world: &World,
     i: usize,
     j: usize,
     plan: &mut OverlapCache,
-    history: &TangentialHistory,
+    history: &mut TangentialHistory,
     laws: &PairLaws,
-) -> Option<ContactForce> {
-    let volume = |plan: &mut OverlapCache| {
-        pair_geometry(world, i, j, plan)
-            .map(|g| pair_force(world, i, j, &g, *history, laws.laws, laws.dt))
+) -> Option<PairResult> {
+    let p = &world.particles;
+    // Each law's contact becomes the pair's result on its own path: a contact merged
+    // from the paths was kept on the stack, and read back by loads that straddled
+    // its stores (a failed store forwarding at every contact).
+    let finish = |c: ContactForce, history: &mut TangentialHistory| {
+        *history = c.history;
+        Some(PairResult::new(&c, &p.position[i], &p.position[j]))
     };
     let RoundLaw::HertzMindlin { rolling } = laws.round else {
-        return volume(plan);
+        let g = pair_geometry(world, i, j, plan)?;
+        return finish(
+            pair_force(world, i, j, &g, *history, laws.laws, laws.dt),
+            history,
+        );
     };
-    let p = &world.particles;
     let (bi, bj) = (p.body_type[i], p.body_type[j]);
     let inputs = |a: usize, b: usize, radius, rolling_inertia| HertzInputs {
         materials: laws.laws.materials(a, b),
@@ -71,9 +73,15 @@ fn pair_contact(
                 effective_radius(a.radius, b.radius),
                 inertia,
             );
-            sphere_pair(world, (i, a), (j, b), law, history)
+            finish(sphere_pair(world, (i, a), (j, b), law, history)?, history)
         }
-        (None, None) => volume(plan),
+        (None, None) => {
+            let g = pair_geometry(world, i, j, plan)?;
+            finish(
+                pair_force(world, i, j, &g, *history, laws.laws, laws.dt),
+                history,
+            )
+        }
         _ => {
             // A sphere and a polyhedron: the polyhedron is locally flat.
             let (ti, tj) = (
@@ -87,14 +95,15 @@ fn pair_contact(
                 1.0 / (1.0 / rolling_inertia(ti, lever(i)) + 1.0 / rolling_inertia(tj, lever(j)));
             let radius = effective_radius(round_radius(&ti.shape), round_radius(&tj.shape));
             let law = inputs(ti.material, tj.material, radius, inertia);
-            Some(round_contact_force(
+            let c = round_contact_force(
                 g.depth,
                 &g.normal,
                 &(g.point - p.position[j]),
                 &motion,
                 &law,
                 history,
-            ))
+            );
+            finish(c, history)
         }
     }
 }
@@ -112,7 +121,7 @@ fn near(p: &Particles, radii: &[Real], [i, j]: [u32; 2]) -> bool {
 
 /// The result of candidate pair `[i, j]`, evaluated where it is [`near`], its history
 /// replaced by the one its contact leaves (empty when they do not touch).
-#[inline]
+#[inline(always)]
 pub(super) fn evaluate_pair(
     world: &World,
     laws: &PairLaws,
@@ -120,110 +129,17 @@ pub(super) fn evaluate_pair(
     history: &mut TangentialHistory,
     plan: &mut OverlapCache,
 ) -> PairResult {
-    let p = &world.particles;
     let (i, j) = (i as usize, j as usize);
-    let c = if near {
-        pair_contact(world, i, j, plan, history, laws)
-    } else {
-        None
-    };
+    if near && let Some(c) = pair_contact(world, i, j, plan, history, laws) {
+        return c;
+    }
     // A pair that stays apart keeps its empty history unwritten.
-    match &c {
-        Some(c) => {
-            *history = c.history;
-            PairResult::new(c, &p.position[i], &p.position[j])
-        }
-        None if !history.is_empty() => {
-            let parted = PairResult::parted(history);
-            *history = TangentialHistory::default();
-            parted
-        }
-        None => PairResult::default(),
+    if history.is_empty() {
+        return PairResult::default();
     }
-}
-
-/// Evaluates the candidate pairs into `results`, in parallel over blocks of pairs
-/// ([`evaluate_block`]); `radii` are the particles' bounding radii, `types` the
-/// table of their body types.
-pub(super) fn pair_contacts(
-    world: &World,
-    list: &NeighbourList,
-    state: &mut ContactState,
-    (radii, types): (&[Real], &TypeTable),
-    laws: PairLaws,
-    results: &mut PairResults,
-) {
-    let pairs = list.pairs();
-    let block = |b: usize,
-                 (results, mask): (&mut [PairResult], &mut u64),
-                 (history, held): BlockHistory,
-                 plans: Option<(&mut [OverlapCache], PairPrefetch)>,
-                 spare: &mut OverlapCache| {
-        let first = b * BLOCK;
-        let pairs = &pairs[first..first + results.len()];
-        let plans = plans.map(|(plans, prefetch)| BlockPlans {
-            plans,
-            prefetch,
-            first,
-        });
-        *mask = evaluate_block(
-            world,
-            radii,
-            &laws,
-            (pairs, history, held),
-            plans,
-            spare,
-            |k, c| {
-                results[k] = c;
-            },
-        );
-    };
-    let with_plans = state.overlap_plans.len() == pairs.len();
-    let (history, held) = (&mut state.pair_history, &mut state.held);
-    if with_plans {
-        let (plans, keeps_contact) = state.overlap_plans.split();
-        let body_type = &world.particles.body_type;
-        // The prefetch keeps where the histories lie; nothing is read through it.
-        let prefetch = PairPrefetch::new((plans, keeps_contact), history, pairs, body_type, types);
-        result_blocks(results, (history, held), pairs.len())
-            .zip(plans.par_chunks_mut(BLOCK))
-            .for_each_init(
-                OverlapCache::default,
-                |spare, ((b, (results, history)), plans)| {
-                    block(b, results, history, Some((plans, prefetch)), spare)
-                },
-            );
-    } else {
-        // A world of spheres keeps no overlap plans (see `ContactState::rebuild`).
-        result_blocks(results, (history, held), pairs.len())
-            .for_each_init(OverlapCache::default, |spare, (b, (results, history))| {
-                block(b, results, history, None, spare)
-            });
-    }
-}
-
-/// A block's pairs' histories, and the mask of those that hold one (see
-/// [`ContactState`]'s invariant).
-type BlockHistory<'a> = (&'a mut [TangentialHistory], &'a mut u64);
-
-/// A block of the pair stage: its number, its results with their mask, and its
-/// pairs' histories.
-type ResultBlock<'a> = (
-    usize,
-    ((&'a mut [PairResult], &'a mut u64), BlockHistory<'a>),
-);
-
-/// The blocks of `pairs` pairs' results (each with its mask) and histories (each
-/// with the mask of those held), numbered.
-fn result_blocks<'a>(
-    results: &'a mut PairResults,
-    (history, held): (&'a mut [TangentialHistory], &'a mut [u64]),
-    pairs: usize,
-) -> impl IndexedParallelIterator<Item = ResultBlock<'a>> {
-    results
-        .blocks_mut(pairs)
-        .zip(history.par_chunks_mut(BLOCK).zip(held.par_iter_mut()))
-        .enumerate()
+    let parted = PairResult::parted(history);
+    *history = TangentialHistory::default();
+    parted
 }
 
 /// The overlap plans of a block of pairs starting at pair `first` of the list.
@@ -292,7 +208,7 @@ pub(super) fn evaluate_block(
 /// where the pairs are spheres; among polyhedra, whose overlap plans the callers
 /// pass, most candidates' bounding spheres overlap, the branch is foreseen, and
 /// sifting first cost about 4 % of the dense bed of `talus bench` (a) on one thread.
-#[inline]
+#[inline(always)]
 fn to_evaluate(sift: bool, p: &Particles, radii: &[Real], pairs: &[[u32; 2]], held: u64) -> u64 {
     if sift {
         busy_pairs(p, radii, pairs, held)
@@ -308,7 +224,7 @@ fn to_evaluate(sift: bool, p: &Particles, radii: &[Real], pairs: &[[u32; 2]], he
 /// about a fifth of its time. The histories themselves are not read: in a bed of
 /// spheres about half of the candidate pairs are apart, and reading their 64-byte
 /// histories to learn that they are empty was a line from memory for each.
-#[inline]
+#[inline(always)]
 fn busy_pairs(p: &Particles, radii: &[Real], pairs: &[[u32; 2]], held: u64) -> u64 {
     debug_assert!(pairs.len() <= BLOCK);
     let mut near_mask = 0u64;
@@ -316,51 +232,6 @@ fn busy_pairs(p: &Particles, radii: &[Real], pairs: &[[u32; 2]], held: u64) -> u
         near_mask |= u64::from(near(p, radii, pair)) << k;
     }
     near_mask | held
-}
-
-/// Sets every owned particle's force to its weight plus its pairs' forces, gathered in
-/// pair order (what a serial sweep over the pairs would add), so the sums do not
-/// depend on the threads; marks the particles that touch. Ghosts get no force.
-/// Returns the contacts' count and energies.
-pub(super) fn gather(
-    world: &mut World,
-    list: &NeighbourList,
-    results: &PairResults,
-    touching: &mut Vec<bool>,
-) -> ContactTotals {
-    let p = &mut world.particles;
-    let owned = p.owned();
-    let start = StartLoads {
-        owned,
-        body_type: &p.body_type,
-        frozen: &p.frozen,
-        types: &world.body_types,
-        gravity: world.gravity,
-    };
-    touching.resize(p.len(), false);
-    (&mut p.force, &mut p.torque, touching)
-        .into_par_iter()
-        .enumerate()
-        .with_min_len(PARTICLES_PER_TASK)
-        .for_each(|(k, (force, torque, touching))| {
-            (*force, *torque, *touching) = start.of(k);
-            if k >= owned {
-                return;
-            }
-            // Adding a pair apart adds zeros: `x + 0.0` is `x`, and `x + (−1)·f` is
-            // `x − f`, so the sums are those of adding the touching pairs alone.
-            for &e in list.incident(k) {
-                let c = results.get(e.pair());
-                c.add_to((force, torque, touching), e.is_first());
-            }
-        });
-    let p = &world.particles;
-    let pairs = list.pairs();
-    let mut totals = ContactTotals::of_candidates(p, pairs);
-    for (k, c) in results.busy() {
-        totals.count(p, pairs[k], c);
-    }
-    totals
 }
 
 /// What a particle carries before its pairs are added: its weight if owned (a ghost
@@ -375,10 +246,22 @@ pub(super) struct StartLoads<'a> {
     pub gravity: Vector3<Real>,
 }
 
-impl StartLoads<'_> {
+impl<'a> StartLoads<'a> {
+    /// The start of every particle of `world`.
+    pub(super) fn of(world: &'a World) -> Self {
+        let p = &world.particles;
+        StartLoads {
+            owned: p.owned(),
+            body_type: &p.body_type,
+            frozen: &p.frozen,
+            types: &world.body_types,
+            gravity: world.gravity,
+        }
+    }
+
     /// Force, torque and touching flag of particle `k` before its pairs.
     #[inline]
-    pub(super) fn of(&self, k: usize) -> (Vector3<Real>, Vector3<Real>, bool) {
+    pub(super) fn of_particle(&self, k: usize) -> (Vector3<Real>, Vector3<Real>, bool) {
         if k >= self.owned {
             return (Vector3::zeros(), Vector3::zeros(), false);
         }

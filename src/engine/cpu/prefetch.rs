@@ -24,8 +24,8 @@
 use std::ops::Range;
 use std::sync::atomic::AtomicU64;
 
+use super::blocks::BLOCK;
 use super::overlap_plans::keeps_contact;
-use super::pair_results::BLOCK;
 use super::type_table::TypeTable;
 use crate::contact::TangentialHistory;
 use crate::geometry::overlap::OverlapCache;
