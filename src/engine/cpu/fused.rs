@@ -349,7 +349,9 @@ impl Sweep<'_> {
     }
 
     /// Sweeps part `m` of several: adds its pairs to the particles of part `m` in
-    /// `sums` and to `totals` (part 0), defers the rest to `deferred`.
+    /// `sums` and to `totals` (part 0), defers the rest to `deferred`. Not inlined:
+    /// called from both arms of the halving, its loop would be copied, and LLVM
+    /// then called the pair's evaluation out of line.
     #[inline(never)]
     fn part(
         &self,
