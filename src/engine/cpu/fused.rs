@@ -116,13 +116,19 @@ impl Parts {
     fn split(&mut self, pairs: usize, count: usize, held: &[u64]) {
         let blocks = pairs.div_ceil(BLOCK);
         let count = count.clamp(1, blocks.max(1));
+        self.starts.clear();
+        self.starts.push(0);
+        if count == 1 {
+            // One part: nothing to weigh.
+            self.starts.push(pairs);
+            self.deferred.resize_with(1, Deferred::default);
+            return;
+        }
         let work = |b: usize| {
             let len = BLOCK.min(pairs - b * BLOCK);
             len + CONTACT_COST * held.get(b).map_or(0, |h| h.count_ones() as usize)
         };
         let total: usize = (0..blocks).map(work).sum();
-        self.starts.clear();
-        self.starts.push(0);
         let mut done = 0;
         for b in 0..blocks {
             done += work(b);
@@ -179,9 +185,8 @@ pub(super) fn pair_contacts_gathered(
         len: n,
     };
     let with_plans = state.overlap_plans.len() == pairs.len();
-    let (plans, keeps_contact) = state.overlap_plans.split();
-    let prefetch = PairPrefetch::new(
-        (plans, keeps_contact),
+    let (plans, prefetch) = PairPrefetch::over(
+        &mut state.overlap_plans,
         &state.pair_history,
         pairs,
         &p.body_type,
@@ -458,9 +463,8 @@ fn sweep_alone(
     let with_plans = state.overlap_plans.len() == list.pairs().len();
     let mut spare = OverlapCache::default();
     let pairs = list.pairs();
-    let (plans, keeps_contact) = state.overlap_plans.split();
-    let prefetch = PairPrefetch::new(
-        (plans, keeps_contact),
+    let (plans, prefetch) = PairPrefetch::over(
+        &mut state.overlap_plans,
         &state.pair_history,
         pairs,
         &p.body_type,

@@ -25,7 +25,7 @@ use std::ops::Range;
 use std::sync::atomic::AtomicU64;
 
 use super::blocks::BLOCK;
-use super::overlap_plans::keeps_contact;
+use super::overlap_plans::{OverlapPlans, keeps_contact};
 use super::type_table::TypeTable;
 use crate::contact::TangentialHistory;
 use crate::geometry::overlap::OverlapCache;
@@ -53,16 +53,17 @@ pub(super) struct PairPrefetch<'a> {
 }
 
 impl<'a> PairPrefetch<'a> {
-    /// Prefetches for the `plans` of the list's `pairs` (and which of them keep a
-    /// contact), of particles of `body_type`.
-    pub(super) fn new(
-        (plans, keeps_contact): (&[OverlapCache], &'a [AtomicU64]),
+    /// The `plans` of the list's `pairs` to evaluate, and the prefetch for them (and
+    /// for the pairs' `history`), of particles of `body_type`.
+    pub(super) fn over(
+        plans: &'a mut OverlapPlans,
         history: &[TangentialHistory],
         pairs: &'a [[u32; 2]],
         body_type: &'a [u32],
         types: &'a TypeTable,
-    ) -> Self {
-        PairPrefetch {
+    ) -> (&'a mut [OverlapCache], Self) {
+        let (plans, keeps_contact) = plans.split();
+        let prefetch = PairPrefetch {
             start: plans.as_ptr().addr(),
             len: plans.len(),
             history: history.as_ptr().addr(),
@@ -70,7 +71,8 @@ impl<'a> PairPrefetch<'a> {
             pairs,
             body_type,
             types,
-        }
+        };
+        (plans, prefetch)
     }
 
     /// The word of the block of pairs starting at pair `first` (a multiple of
