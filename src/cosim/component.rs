@@ -632,15 +632,15 @@ impl Component {
     }
 
     /// Each particle's id and what the fluid does to it (drag of the last force
-    /// evaluation, slip, local voidage: [`ParticleFluid`]), in the simulation's
-    /// order (on ranks collective: the whole run's, in id order, on rank 0, empty
-    /// lists on the others); before initialisation the scene's particles at rest in
-    /// the start fields (no drag yet). Particles come and go, so this crosses the
-    /// faces as whole lists (C API, zenoh), not as variables.
+    /// evaluation, slip, local voidage: [`ParticleFluid`]), in id order (on ranks
+    /// collective: the whole run's on rank 0, empty lists on the others); before
+    /// initialisation the scene's particles at rest in the start fields (no drag
+    /// yet). Particles come and go, so this crosses the faces as whole lists (C
+    /// API, zenoh), not as variables.
     pub fn particle_fluid(&self) -> Result<(Vec<u64>, Vec<ParticleFluid>), CosimError> {
         let world = self.world();
         let fluid = world.fluid.as_ref().ok_or(CosimError::NoFluid)?;
-        if let (Some(_), Some(sim)) = (&self.ranks, &self.sim) {
+        if let Some(sim) = &self.sim {
             return Ok(sim.whole_particle_fluid().unwrap_or_default());
         }
         let p = &world.particles;

@@ -166,10 +166,12 @@ impl Simulation {
     pub fn whole_particle_fluid(&self) -> Option<(Vec<u64>, Vec<ParticleFluid>)> {
         let fluid = self.world.fluid.as_ref()?;
         let p = &self.world.particles;
-        let mine: Vec<(u64, ParticleFluid)> = (0..p.owned())
+        let mut mine: Vec<(u64, ParticleFluid)> = (0..p.owned())
             .map(|i| (p.id[i], fluid.at_particle(p, i)))
             .collect();
         let Some(share) = self.backend.share() else {
+            // Stored in the space order.
+            mine.sort_unstable_by_key(|(id, _)| *id);
             return Some(mine.into_iter().unzip());
         };
         let gathered = gather_to_first(share, &mine);

@@ -11,9 +11,9 @@
 //! later part that meets the particle defers that pair's result. After the sweep the
 //! deferred results are added part by part, in pair order: the particle gets the
 //! additions of a single sweep, in its order, whatever the number of parts. The
-//! totals are summed in pair order likewise (the later parts' terms are kept and
-//! summed after the first part's). So a run on one thread is bit for bit a run on
-//! many (`tests/thread_count.rs`).
+//! totals are summed block by block ([`ContactTotals`]): the later parts keep their
+//! blocks' sums, added after the first part's in block order. So a run on one
+//! thread is bit for bit a run on many (`tests/thread_count.rs`).
 //!
 //! # Why
 //! A results array is pure traffic: every pair's 88-byte result was written, then
@@ -60,11 +60,11 @@ pub(super) struct Parts {
 }
 
 /// What a part kept back: the results of its pairs with a particle of an earlier
-/// part, and the terms of its totals, each in pair order.
+/// part, in pair order, and the sums of its blocks, in block order.
 #[derive(Clone, Debug, Default)]
 struct Deferred {
     results: Vec<(u32, PairResult)>,
-    totals: Vec<(bool, Real, Real)>,
+    blocks: Vec<ContactTotals>,
     /// The overlap plan of the pairs without one (spheres).
     spare: OverlapCache,
 }
@@ -242,10 +242,8 @@ pub(super) fn add_deferred(
                 }
             }
         }
-        for &(t, energy, dissipated) in &d.totals {
-            totals.contacts += usize::from(t);
-            totals.energy += energy;
-            totals.dissipated += dissipated;
+        for block in &d.blocks {
+            totals.add_block(block);
         }
     }
     totals
@@ -366,17 +364,16 @@ impl Sweep<'_> {
         totals: &mut ContactTotals,
         deferred: &mut Deferred,
     ) {
-        let p = &self.world.particles;
         deferred.results.clear();
-        deferred.totals.clear();
+        deferred.blocks.clear();
         let Deferred {
             results,
-            totals: terms,
+            blocks,
             spare,
         } = deferred;
         let part = m as u32;
         let mut sum = *totals;
-        self.blocks(slices, spare, |pair, k, c| {
+        let take = |pair: [u32; 2], k: usize, c: &PairResult| {
             let mut defer = false;
             for (particle, first) in [(pair[0] as usize, true), (pair[1] as usize, false)] {
                 // A ghost's sums stay zero.
@@ -392,24 +389,27 @@ impl Sweep<'_> {
             if defer {
                 results.push((k as u32, *c));
             }
-            if m == 0 {
-                sum.count(p, pair, c);
-            } else if p.counts_pair(pair[0] as usize, pair[1] as usize) {
-                terms.push((c.touching, c.energy, c.dissipated));
-            }
-        });
+        };
+        if m == 0 {
+            self.blocks(slices, spare, take, |block| sum.add_block(block));
+        } else {
+            self.blocks(slices, spare, take, |block| blocks.push(*block));
+        }
         *totals = sum;
     }
 
     /// Evaluates the pairs of `slices` block by block, in pair order, handing each
-    /// busy pair's particles, index in the list and result to `take`.
+    /// busy pair's particles, index in the list and result to `take`, and each
+    /// block's sums to `block_sums`.
     #[inline(always)]
     fn blocks(
         &self,
         slices: PartSlices,
         spare: &mut OverlapCache,
         mut take: impl FnMut([u32; 2], usize, &PairResult),
+        mut block_sums: impl FnMut(&ContactTotals),
     ) {
+        let p = &self.world.particles;
         let PartSlices {
             pairs: range,
             history,
@@ -425,6 +425,7 @@ impl Sweep<'_> {
                 first: start,
             });
             let block_pairs = &self.pairs[block];
+            let mut sums = ContactTotals::default();
             evaluate_block(
                 self.world,
                 self.radii,
@@ -432,8 +433,12 @@ impl Sweep<'_> {
                 (block_pairs, &mut history[local], &mut held[b]),
                 plans,
                 spare,
-                |k, c| take(block_pairs[k], start + k, &c),
+                |k, c| {
+                    take(block_pairs[k], start + k, &c);
+                    sums.count(p, block_pairs[k], &c);
+                },
             );
+            block_sums(&sums);
         }
     }
 }
@@ -481,6 +486,7 @@ fn sweep_alone(
         let block_pairs = &pairs[block.clone()];
         let history = &mut state.pair_history[block];
         let held = &mut state.held[first / BLOCK];
+        let mut sums = ContactTotals::default();
         evaluate_block(
             world,
             radii,
@@ -503,9 +509,10 @@ fn sweep_alone(
                         );
                     }
                 }
-                totals.count(p, pair, &c);
+                sums.count(p, pair, &c);
             },
         );
+        totals.add_block(&sums);
     }
     world.particles.force = force;
     world.particles.torque = torque;

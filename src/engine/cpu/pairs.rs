@@ -286,7 +286,10 @@ impl PairResult {
 }
 
 /// A force evaluation's contacts, summed in pair order, then wall contacts in
-/// particle order.
+/// particle order. The pairs' energies are summed block by block: each block of
+/// [`BLOCK`] pairs from zero in pair order, then the blocks' sums in block order,
+/// so that the parts of a sweep on many threads each sum their own blocks and the
+/// bits do not depend on the number of parts.
 #[derive(Clone, Copy, Debug, Default)]
 pub(super) struct ContactTotals {
     /// Candidate pairs (of the pair stage).
@@ -302,11 +305,17 @@ impl ContactTotals {
     /// No contacts yet, and the candidate pairs among `pairs` that this world counts
     /// (see [`Particles::counts_pair`]).
     pub(super) fn of_candidates(p: &Particles, pairs: &[[u32; 2]]) -> Self {
-        ContactTotals {
-            candidates: pairs
-                .iter()
+        // Without ghosts every pair counts: the pass over the pairs, serial, took
+        // 2 % of a step of a settled bed of spheres.
+        let candidates = if p.ghosts() == 0 {
+            pairs.len()
+        } else {
+            (pairs.iter())
                 .filter(|&&[i, j]| p.counts_pair(i as usize, j as usize))
-                .count(),
+                .count()
+        };
+        ContactTotals {
+            candidates,
             ..Default::default()
         }
     }
@@ -323,5 +332,13 @@ impl ContactTotals {
         self.contacts += usize::from(c.touching);
         self.energy += c.energy;
         self.dissipated += c.dissipated;
+    }
+
+    /// Adds the contacts of `block` (a block's sums, [`Self::count`]ed from zero).
+    #[inline]
+    pub(super) fn add_block(&mut self, block: &ContactTotals) {
+        self.contacts += block.contacts;
+        self.energy += block.energy;
+        self.dissipated += block.dissipated;
     }
 }
