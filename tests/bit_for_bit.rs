@@ -43,7 +43,7 @@ const CASES: [Case; 3] = [
             0x17ed34423bde0539,
             0xb65e1ed59af58ef2,
             0xee638a32aac71c74,
-            0x60a3b2ff30af4bbe,
+            0x6de701ba6a07fb4a,
         ],
     },
     Case {

@@ -191,8 +191,11 @@ fn hands_over(mut c: Component, scene: Scene, cells: usize, each_communication: 
     let (ids, each) = c.particle_fluid().unwrap();
     let world = sim.world();
     let fluid = sim.fluid().unwrap();
-    assert_eq!(ids, world.particles.id[..world.particles.owned()]);
-    for (i, f) in each.iter().enumerate() {
+    let mut by_id = world.particles.id[..world.particles.owned()].to_vec();
+    by_id.sort_unstable();
+    assert_eq!(ids, by_id, "every particle once, in id order");
+    for (id, f) in ids.iter().zip(&each) {
+        let i = world.particles.index_of(*id).unwrap();
         assert_eq!(*f, fluid.at_particle(&world.particles, i));
         assert!(f.voidage > 0.0 && f.voidage <= 1.0, "{f:?}");
     }

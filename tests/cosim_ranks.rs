@@ -16,7 +16,7 @@ use std::path::Path;
 
 use talus::cosim::{Component, CosimError, VarRef};
 use talus::engine::exchange::ThreadExchange;
-use talus::scene::SimState;
+use talus::scene::{FluidState, SimState};
 
 fn root() -> &'static Path {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -393,7 +393,22 @@ fn assert_same_fluid(a: &FluidReport, b: &FluidReport) {
         "each particle's fluid"
     );
     let (fa, fb) = (sa.fluid.as_ref().unwrap(), sb.fluid.as_ref().unwrap());
-    assert!(fa.shares == fb.shares && fa.exchange.drag == fb.exchange.drag);
+    // By id: one process stores its particles in the space order, the ranks'
+    // gathered state in id order.
+    let ids = |s: &SimState| {
+        let mut ids = s.particles.id.clone();
+        ids.sort_unstable();
+        ids
+    };
+    let rows = |s: &SimState, f: &FluidState| -> Vec<_> {
+        ids(s).into_iter().map(|id| f.shares.row_of(id)).collect()
+    };
+    let drag = |s: &SimState, f: &FluidState| {
+        let mut drag: Vec<_> = s.particles.id.iter().zip(&f.exchange.drag).collect();
+        drag.sort_unstable_by_key(|e| *e.0);
+        drag.into_iter().map(|e| *e.1).collect::<Vec<_>>()
+    };
+    assert!(rows(sa, fa) == rows(sb, fb) && drag(sa, fa) == drag(sb, fb));
     let flat = |v: &[nalgebra::Vector3<f64>]| v.iter().flat_map(|x| x.iter().copied()).collect();
     for (name, x, y) in [
         ("momentum source", &a.momentum_source, &b.momentum_source),

@@ -408,36 +408,42 @@ fn a_state_of_version_7_still_restores() {
     let mut bytes = w.into_bytes();
     assert_eq!(&bytes[..8], b"TALUSST8");
     assert_eq!(bytes.split_off(bytes.len() - 8), [0; 8], "no list: flag 0");
-    // Nor each particle's cell code, the last of its 23 words (none placed yet:
-    // the space order is first refreshed after 1000 steps).
+    // Nor each particle's cell code, the last of its 23 words (placed: a
+    // simulation starts in the space order). Version 7 reads as version 8 with
+    // every code `NO_CELL`: the reference.
     let count_at = 8 + 8 * 15;
     let word = |at: usize| u64::from_le_bytes(bytes[at..at + 8].try_into().unwrap());
     let n = word(count_at) as usize;
     assert_eq!(n, saved.world().particles.len());
     let first = count_at + 8;
-    let mut v7 = bytes[..first].to_vec();
+    let (mut v7, mut uncoded) = (bytes[..first].to_vec(), bytes[..first].to_vec());
     for k in 0..n {
         let record = first + 8 * 23 * k;
-        assert_eq!(word(record + 8 * 22), Particles::NO_CELL, "particle {k}");
+        assert_ne!(word(record + 8 * 22), Particles::NO_CELL, "particle {k}");
         v7.extend_from_slice(&bytes[record..record + 8 * 22]);
+        uncoded.extend_from_slice(&bytes[record..record + 8 * 22]);
+        uncoded.extend_from_slice(&Particles::NO_CELL.to_le_bytes());
     }
     v7.extend_from_slice(&bytes[first + 8 * 23 * n..]);
-    let mut bytes = v7;
-    bytes[7] = b'7';
-    let mut restored = Simulation::new(&scene);
-    restored
-        .read_state(3, &mut StateReader::new(&bytes))
-        .unwrap();
+    uncoded.extend_from_slice(&bytes[first + 8 * 23 * n..]);
+    uncoded.extend_from_slice(&[0; 8]);
+    v7[7] = b'7';
+    let read = |bytes: &[u8]| {
+        let mut sim = Simulation::new(&scene);
+        sim.read_state(3, &mut StateReader::new(bytes)).unwrap();
+        sim
+    };
+    let (mut restored, mut reference) = (read(&v7), read(&uncoded));
     assert_eq!(restored.snapshot().list, None);
-    for sim in [&mut saved, &mut restored] {
+    for sim in [&mut reference, &mut restored] {
         let _ = sim.advance_to(3e-3, |_, _| ControlFlow::<()>::Continue(()));
     }
     assert_eq!(
-        saved.world().particles.position,
+        reference.world().particles.position,
         restored.world().particles.position
     );
     assert_eq!(
-        saved.world().particles.velocity,
+        reference.world().particles.velocity,
         restored.world().particles.velocity
     );
 }

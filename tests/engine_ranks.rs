@@ -247,6 +247,8 @@ start = 0.04
                         for inlet in &mut inlets {
                             placed += inlet.insert_due(&mut world, 0.0, &mut next_id);
                         }
+                        // Coded as a simulation starts.
+                        world.refresh_space_order(false);
                         let (params, history) = (scene.step_params(), ContactHistory::default());
                         let mut rank = RankStepper::new(
                             exchange, layout, params, &mut world, &history, scene.dt,

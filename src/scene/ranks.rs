@@ -65,6 +65,8 @@ impl Simulation {
         for inlet in &mut inlets {
             inlet.insert_due(&mut world, 0.0, &mut next_id);
         }
+        // Coded as one process starts (each rank keeps the places).
+        world.refresh_space_order(false);
         let seeds = seeds_of(&world);
         let layout = Decomposition::bisect(&seeds, &vec![1.0; seeds.len()], exchange.size());
         let stepper = backend.stepper(

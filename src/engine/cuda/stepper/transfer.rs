@@ -113,21 +113,26 @@ impl DeviceWorld {
         self.order.extend(from..n);
         self.slot_of.extend((from..n).map(|k| k as u32));
         self.owned = p.owned();
-        let (d, a) = (self.device.as_mut(), &mut self.particles);
-        grow(d, &mut a.position, from, n, |r| points(&p.position[r]))?;
-        grow(d, &mut a.velocity, from, n, |r| vectors(&p.velocity[r]))?;
-        grow(d, &mut a.orientation, from, n, |r| {
-            quaternions(&p.orientation[r])
+        let (d, a, order) = (self.device.as_mut(), &mut self.particles, &self.order[..]);
+        let at = (order, from);
+        grow(d, &mut a.position, at, |e| {
+            points(&in_order(&p.position, e))
         })?;
-        grow(d, &mut a.angular_momentum, from, n, |r| {
-            vectors(&p.angular_momentum[r])
+        grow(d, &mut a.velocity, at, |e| {
+            vectors(&in_order(&p.velocity, e))
         })?;
-        grow(d, &mut a.force, from, n, |r| vectors(&p.force[r]))?;
-        grow(d, &mut a.torque, from, n, |r| vectors(&p.torque[r]))?;
-        grow(d, &mut a.body_type, from, n, |r| p.body_type[r].to_vec())?;
-        grow(d, &mut a.role, from, n, |r| roles(p, r))?;
-        grow(d, &mut a.id, from, n, |r| p.id[r].to_vec())?;
-        grow(d, &mut a.cell_code, from, n, |r| p.cell_code[r].to_vec())?;
+        grow(d, &mut a.orientation, at, |e| {
+            quaternions(&in_order(&p.orientation, e))
+        })?;
+        grow(d, &mut a.angular_momentum, at, |e| {
+            vectors(&in_order(&p.angular_momentum, e))
+        })?;
+        grow(d, &mut a.force, at, |e| vectors(&in_order(&p.force, e)))?;
+        grow(d, &mut a.torque, at, |e| vectors(&in_order(&p.torque, e)))?;
+        grow(d, &mut a.body_type, at, |e| in_order(&p.body_type, e))?;
+        grow(d, &mut a.role, at, |e| roles(p, e.iter().copied()))?;
+        grow(d, &mut a.id, at, |e| in_order(&p.id, e))?;
+        grow(d, &mut a.cell_code, at, |e| in_order(&p.cell_code, e))?;
         a.touching.resize(d, n)?;
         self.walls.grow(d, n)?;
         self.n = n;
@@ -240,18 +245,20 @@ impl DeviceWorld {
     }
 }
 
-/// Grows `array` from the values of particles `..from` to those of `..n`, given by
-/// `values` for a range of particles: the new particles' appended where the buffer
-/// has room, all of them uploaded again where not.
+/// Grows `array` from the values of device slots `..from` to those of every slot
+/// of `order` (each slot's host entry), `values` giving the values of host entries
+/// in the order asked: the new slots' appended where the buffer has room, all of
+/// them uploaded again where not, in the device's order (the host's differs once
+/// it stores the particles in the space order: uploaded in the host's order, a
+/// pour from an inlet onto a bed stored so scrambled the device's particles).
 fn grow<T: bytemuck::Pod>(
     device: &mut dyn Device,
     array: &mut Array<T>,
-    from: usize,
-    n: usize,
-    values: impl Fn(std::ops::Range<usize>) -> Vec<T>,
+    (order, from): (&[usize], usize),
+    values: impl Fn(&[usize]) -> Vec<T>,
 ) -> Result<(), DeviceError> {
-    if !array.append(device, &values(from..n))? {
-        array.write(device, &values(0..n))?;
+    if !array.append(device, &values(&order[from..]))? {
+        array.write(device, &values(order))?;
     }
     Ok(())
 }
