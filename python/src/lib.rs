@@ -162,13 +162,17 @@ impl Scene {
         Ok(f(sim.world()))
     }
 
-    /// What the fluid does to each particle, in the order of the particle arrays.
+    /// What the fluid does to each particle, in the order of the particle arrays (the
+    /// component lists it by id; the arrays follow the world's storage).
     fn particle_fluid(&self) -> PyResult<Vec<talus::world::ParticleFluid>> {
-        self.read(|c| {
-            c.particle_fluid()
-                .map(|(_, each)| each)
-                .map_err(|e| e.to_string())
-        })
+        let (ids, each) = self.read(|c| c.particle_fluid().map_err(|e| e.to_string()))?;
+        self.with_world(|w| {
+            let p = &w.particles;
+            (0..p.owned())
+                .map(|i| ids.binary_search(&p.id[i]).map(|k| each[k]))
+                .collect::<Result<Vec<_>, _>>()
+        })?
+        .map_err(|_| TalusError::new_err("a particle without its fluid row"))
     }
 
     /// One value per owned particle, `width` reals each, as an `(n, width)` array.
