@@ -551,8 +551,7 @@ pub unsafe extern "C" fn talus_get_particle_count(
 /// its id, the drag of the last force evaluation (x y z, N), the slip (the fluid's
 /// velocity at the particle less its own, x y z, m/s) and the local void fraction.
 /// `ids` and `voidage` have room for `n` values, `drag` and `slip` for `3 n`.
-/// Particles come in the order they are stored in, which changes every 1000 steps
-/// (by their place in space): match them by id.
+/// Particles come in the order of their ids (on ranks too).
 ///
 /// # Safety
 /// `handle` is a live component; the arrays have room as stated.
