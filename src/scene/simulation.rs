@@ -116,9 +116,7 @@ impl Simulation {
         sim.insert();
         // The particles due at 0 are in: they start in the space order (the
         // schedule's first refresh comes at step 1000).
-        if sim.world.refresh_space_order(true) {
-            sim.backend.particles_removed(&sim.world);
-        }
+        sim.refresh_space_order();
         sim.update_fluid();
         sim.backend.initialise(&mut sim.world, sim.dt);
         sim.energy = EnergyLedger::new(&sim.held_energy());
@@ -413,8 +411,9 @@ impl Simulation {
         self.update_settling();
     }
 
-    /// Places the owned particles in the space order anew, at the steps of its
-    /// schedule (so on every rank together, and after a restart as before it). A
+    /// Places the owned particles in the space order anew, at the start and at the
+    /// steps of its schedule (so on every rank together, and after a restart as
+    /// before it). A
     /// rank codes its particles but keeps their places: it sends the states of
     /// those that are ghosts elsewhere by their places until the next renewal of
     /// the lists, which the change causes.
