@@ -250,6 +250,11 @@ pub(super) fn add_deferred(
 }
 
 /// Sets every particle's sums to its start ([`StartLoads`]) and finds its part.
+///
+/// By chunks with a loop over indices: a closure per particle that returned its
+/// start and part as a tuple was called out of line, its result read back from the
+/// stack by loads that straddled its stores, and the pass took 58–90 µs a step of
+/// the settled bed of 5000 spheres on two threads (27–35 µs now).
 fn start_sums(
     start: &StartLoads,
     list: &NeighbourList,
@@ -258,16 +263,23 @@ fn start_sums(
 ) {
     let mut lowest = std::mem::take(&mut parts.lowest);
     lowest.resize(force.len(), u32::MAX);
-    let of = |k: usize| {
-        let part = (list.incident(k).first()).map_or(u32::MAX, |e| parts.of_pair(e.pair()));
-        (start.of_particle(k), part)
-    };
-    (force, torque, touching, &mut lowest[..])
+    let part_of = &*parts;
+    (
+        force.par_chunks_mut(PARTICLES_PER_TASK),
+        torque.par_chunks_mut(PARTICLES_PER_TASK),
+        touching.par_chunks_mut(PARTICLES_PER_TASK),
+        lowest.par_chunks_mut(PARTICLES_PER_TASK),
+    )
         .into_par_iter()
         .enumerate()
-        .with_min_len(PARTICLES_PER_TASK)
-        .for_each(|(k, (force, torque, touching, lowest))| {
-            ((*force, *torque, *touching), *lowest) = of(k);
+        .for_each(|(c, (force, torque, touching, lowest))| {
+            let first = c * PARTICLES_PER_TASK;
+            for (o, lowest) in lowest.iter_mut().enumerate() {
+                let k = first + o;
+                (force[o], torque[o], touching[o]) = start.of_particle(k);
+                let incident = list.incident(k).first();
+                *lowest = incident.map_or(u32::MAX, |e| part_of.of_pair(e.pair()));
+            }
         });
     parts.lowest = lowest;
 }

@@ -260,7 +260,7 @@ impl<'a> StartLoads<'a> {
     }
 
     /// Force, torque and touching flag of particle `k` before its pairs.
-    #[inline]
+    #[inline(always)]
     pub(super) fn of_particle(&self, k: usize) -> (Vector3<Real>, Vector3<Real>, bool) {
         if k >= self.owned {
             return (Vector3::zeros(), Vector3::zeros(), false);
