@@ -74,9 +74,12 @@ shape = "ball"
 material = "glass"
 file = "{poses}"
 
+# Frames of points, as LIGGGHTS's dumps (id x y z): icospheres are 45 MB a frame
+# of 5000 spheres, written inside talus's timed run.
 [output]
 frame_interval = {end_time}
 csv_interval = {end_time}
+spheres = "points"
 """
 
 
