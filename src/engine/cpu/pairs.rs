@@ -170,7 +170,7 @@ pub(super) fn evaluate_block(
         !sift || *held == held_mask(history),
         "the held mask is the histories'"
     );
-    let mask = to_evaluate(sift, p, radii, pairs, *held);
+    let (mask, sifted_near) = to_evaluate(sift, p, radii, pairs, *held);
     // The pairs whose plan was read (near), and of them those that keep a contact;
     // the pairs that hold a history after (a pair left out kept its empty one).
     let (mut read, mut kept, mut holds) = (0u64, 0u64, 0u64);
@@ -182,7 +182,12 @@ pub(super) fn evaluate_block(
             }
             None => &mut *spare,
         };
-        let near = near(p, radii, pairs[k]);
+        // A sifted block's near pairs are known: testing them again took 4 % of
+        // the one-thread pair stage of the settled bed of spheres.
+        let near = match sifted_near {
+            Some(bits) => (bits >> k) & 1 == 1,
+            None => near(p, radii, pairs[k]),
+        };
         take(
             k,
             evaluate_pair(world, laws, (pairs[k], near), &mut history[k], plan),
@@ -203,35 +208,44 @@ pub(super) fn evaluate_block(
 }
 
 /// The mask of the pairs of a block to evaluate (at most [`BLOCK`]; `held`: those
-/// holding a history): the busy ones ([`busy_pairs`]) if `sift`, else all of them
+/// holding a history) and, where they were sifted, the mask of those [`near`]: if
+/// `sift`, the busy ones ([`near_pairs`] or holding a history), else all of them
 /// (an evaluation of a pair with nothing to do leaves it as it was). Sifting pays
 /// where the pairs are spheres; among polyhedra, whose overlap plans the callers
 /// pass, most candidates' bounding spheres overlap, the branch is foreseen, and
 /// sifting first cost about 4 % of the dense bed of `talus bench` (a) on one thread.
 #[inline(always)]
-fn to_evaluate(sift: bool, p: &Particles, radii: &[Real], pairs: &[[u32; 2]], held: u64) -> u64 {
+fn to_evaluate(
+    sift: bool,
+    p: &Particles,
+    radii: &[Real],
+    pairs: &[[u32; 2]],
+    held: u64,
+) -> (u64, Option<u64>) {
     if sift {
-        busy_pairs(p, radii, pairs, held)
+        let near = near_pairs(p, radii, pairs);
+        (near | held, Some(near))
     } else {
-        u64::MAX >> (BLOCK - pairs.len())
+        (u64::MAX >> (BLOCK - pairs.len()), None)
     }
 }
 
-/// The mask of the pairs of a block (at most [`BLOCK`]) that have something to do:
-/// they are [`near`], or they hold a history (`held`) that parting lets go. Found
-/// without a branch per pair: whether a pair touches is as good as a coin toss in a
-/// dense bed, and a mispredicted branch for every other candidate pair cost the sweep
-/// about a fifth of its time. The histories themselves are not read: in a bed of
-/// spheres about half of the candidate pairs are apart, and reading their 64-byte
-/// histories to learn that they are empty was a line from memory for each.
+/// The mask of the pairs of a block (at most [`BLOCK`]) that are [`near`]: with the
+/// pairs holding a history (which parting lets go), those with something to do.
+/// Found without a branch per pair: whether a pair touches is as good as a coin
+/// toss in a dense bed, and a mispredicted branch for every other candidate pair
+/// cost the sweep about a fifth of its time. The histories themselves are not read:
+/// in a bed of spheres about half of the candidate pairs are apart, and reading
+/// their 64-byte histories to learn that they are empty was a line from memory for
+/// each.
 #[inline(always)]
-fn busy_pairs(p: &Particles, radii: &[Real], pairs: &[[u32; 2]], held: u64) -> u64 {
+fn near_pairs(p: &Particles, radii: &[Real], pairs: &[[u32; 2]]) -> u64 {
     debug_assert!(pairs.len() <= BLOCK);
     let mut near_mask = 0u64;
     for (k, &pair) in pairs.iter().enumerate() {
         near_mask |= u64::from(near(p, radii, pair)) << k;
     }
-    near_mask | held
+    near_mask
 }
 
 /// What a particle carries before its pairs are added: its weight if owned (a ghost
