@@ -47,6 +47,30 @@ static __device__ __forceinline__ bool sphere_facet(const double* t, Vec3 centre
     return true;
 }
 
+// A sphere's contact with the face of a facet (unit normal n) its centre projects
+// into, `height` above the facet's plane: the plane's contact, without the
+// closest-point search (geometry/sphere.rs `sphere_on_face`; the edges' inward
+// normals n × (b − a) are the ones engine/cpu/walls.rs places once per facet).
+static __device__ __forceinline__ bool sphere_on_face(const double* t, Vec3 n, Vec3 centre,
+                                                      double r, double height,
+                                                      FacetContact* out) {
+    Vec3 a = load3(t, 0), b = load3(t, 1), c = load3(t, 2);
+    bool inside = (dot(cross(n, sub(b, a)), sub(centre, a)) >= 0.0) &
+                  (dot(cross(n, sub(c, b)), sub(centre, b)) >= 0.0) &
+                  (dot(cross(n, sub(a, c)), sub(centre, c)) >= 0.0);
+    if (!inside || !(height < r)) {
+        return false;
+    }
+    double depth = r - height;
+    Vec3 projection = sub(centre, scale(n, height));
+    out->depth = depth;
+    out->normal = n;
+    out->point = sub(projection, scale(n, 0.5 * depth));
+    out->volume = cap_volume(r, depth);
+    out->area = cap_area(r, depth);
+    return true;
+}
+
 // One thread per sphere: its wall contacts (see the file's head), none for a
 // passive one (frozen or a ghost); a particle of a type that is no sphere
 // (`type_sphere` 0) is left alone, its slots and load untouched (a world of
@@ -92,12 +116,14 @@ extern "C" __global__ void sphere_walls(
     FacetGrids grids = FacetGrids{grid_frame, grid_head, grid_starts, grid_entries};
     unsigned made = 0;
     for (unsigned w = 0; w < walls; ++w) {
-        // The patches of this wall: key, the deepest facet's contact, its facet and
+        // The patches of this wall: key, the deepest facet's contact (a face
+        // contact wins and closes the patch: engine/cpu/patch.rs), its facet and
         // share.
         long long patch_key[WALL_SLOTS][4];
         FacetContact patch[WALL_SLOTS];
         unsigned patch_facet[WALL_SLOTS];
         double patch_share[WALL_SLOTS];
+        bool patch_face[WALL_SLOTS];
         unsigned patches = 0;
         FacetQuery near = facet_query(grids, w, x, r);
         for (unsigned j = next_facet(&near, 0); j != NO_FACET; j = next_facet(&near, j + 1)) {
@@ -108,16 +134,20 @@ extern "C" __global__ void sphere_walls(
             if (!(height >= 0.0 && height <= r)) {
                 continue;
             }
-            FacetContact g;
-            if (!sphere_facet(tri, x, r, &g)) {
-                continue;
-            }
             long long key[4];
             plane_key(nrm, load3(tri, 0), r, key);
             unsigned p = 0;
             while (p < patches && !(patch_key[p][0] == key[0] && patch_key[p][1] == key[1] &&
                                     patch_key[p][2] == key[2] && patch_key[p][3] == key[3])) {
                 ++p;
+            }
+            if (p < patches && patch_face[p]) {
+                continue;
+            }
+            FacetContact g;
+            bool face = sphere_on_face(tri, nrm, x, r, height, &g);
+            if (!face && !sphere_facet(tri, x, r, &g)) {
+                continue;
             }
             if (p == patches) {
                 if (patches == WALL_SLOTS) {
@@ -130,11 +160,13 @@ extern "C" __global__ void sphere_walls(
                 patch[p] = g;
                 patch_facet[p] = k;
                 patch_share[p] = g.volume;
+                patch_face[p] = face;
                 ++patches;
-            } else if (g.depth > patch[p].depth) {
+            } else if (face || g.depth > patch[p].depth) {
                 patch[p] = g;
                 patch_facet[p] = k;
                 patch_share[p] = 1.0;
+                patch_face[p] = face;
             }
         }
         const double* wm = wall_motion + 9 * w;

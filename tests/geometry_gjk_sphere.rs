@@ -9,8 +9,10 @@ use talus::geometry::generators;
 use talus::geometry::gjk::{GjkResult, PointShape, gjk};
 use talus::geometry::overlap::overlap;
 use talus::geometry::sphere::{
-    TriangleFeature, cap_volume, sphere_polyhedron, sphere_sphere, sphere_triangle,
+    TriangleFeature, cap_volume, inward_edge_normals, sphere_on_face, sphere_polyhedron,
+    sphere_sphere, sphere_triangle,
 };
+use talus::geometry::wall::facet_normal;
 
 /// Distance from `p` to the axis-aligned box of half-sizes `h` centred at the origin.
 fn box_distance(p: &Point3<f64>, h: &Vector3<f64>) -> f64 {
@@ -166,6 +168,49 @@ fn sphere_against_triangle_features() {
     let (c, _) = sphere_triangle(&t, &Point3::new(0.2, 0.2, -0.1), 0.15).unwrap();
     assert!((c.normal + Vector3::z()).norm() < 1e-15);
     assert!(sphere_triangle(&t, &Point3::new(0.2, 0.2, 0.2), 0.15).is_none());
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(2000))]
+
+    /// The face test agrees with the closest-point search: over a random triangle a
+    /// sphere whose centre projects into it gets the plane's contact (the search's
+    /// face contact to round-off), and where the search's closest point is an edge
+    /// or a vertex the face test leaves it to the search. Between the two lies only
+    /// a band of round-off along the edges, where either answer is the other's to
+    /// 1e-12 of the size.
+    #[test]
+    fn face_contacts_are_the_closest_point_search_s(
+        corners in prop::array::uniform3(prop::array::uniform3(-1.0f64..1.0)),
+        (u, v) in (-0.5f64..1.5, -0.5f64..1.5),
+        above in 0.0f64..=1.0,
+        r in 0.05f64..1.0,
+    ) {
+        let t = corners.map(Point3::from);
+        let n = facet_normal(&t);
+        prop_assume!((t[1] - t[0]).cross(&(t[2] - t[0])).norm() > 1e-3);
+        // A centre over the triangle's plane, inside and around it.
+        let c = t[0] + (t[1] - t[0]) * u + (t[2] - t[0]) * v + n * (above * r);
+        let height = n.dot(&(c - t[0]));
+        prop_assume!((0.0..=r).contains(&height));
+        let edges = inward_edge_normals(&t, &n);
+        let face = sphere_on_face(&t, &n, &edges, &c, r, height);
+        match (face, sphere_triangle(&t, &c, r)) {
+            (Some(f), Some((s, feature))) => {
+                prop_assert!((f.depth - s.depth).abs() < 1e-12, "{f:?} {s:?}");
+                prop_assert!((f.normal - s.normal).norm() < 1e-9 || feature != TriangleFeature::Face);
+                prop_assert!((f.point - s.point).norm() < 1e-12 || feature != TriangleFeature::Face);
+                prop_assert_eq!(f.normal, n);
+                prop_assert!((f.depth - (r - height)).abs() == 0.0);
+            }
+            (Some(f), None) => prop_assert!(f.depth < 1e-12, "{f:?}"),
+            (None, Some((s, feature))) => {
+                // Outside the face, or exactly touching: the search's edge or vertex.
+                prop_assert!(feature != TriangleFeature::Face || s.depth < 1e-12, "{s:?} {feature:?}");
+            }
+            (None, None) => {}
+        }
+    }
 }
 
 /// Near contact, GJK once added a support point coplanar with the nearest face of

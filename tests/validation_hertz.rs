@@ -142,6 +142,58 @@ bodies = [{{ position = [0.0, 0.0, {z}], velocity = [0.0, 0.0, {vz}] }}]
     sim.world().particles.velocity[0].z / v
 }
 
+/// Spheres resting on a flat floor made of two triangles feel the plane wherever
+/// their centres fall on the triangulation: one contact each, a force along the
+/// floor's normal to the bit (the plane's contact, not a closest point found on a
+/// triangle to round-off, which tilted it by ~1e-16) and Hertz's static force.
+#[test]
+fn spheres_on_a_triangulated_floor_feel_the_plane() {
+    let (r, depth, young, nu): (f64, f64, f64, f64) = (0.005, 1e-5, 1e7, 0.3);
+    // A 7 × 7 grid 13.7 mm apart, off the floor's diagonal by at least 1 mm.
+    let bodies: Vec<String> = (0..49)
+        .map(|k| {
+            let (x, y) = (
+                -0.042 + 0.0137 * (k / 7) as f64,
+                -0.0405 + 0.0137 * (k % 7) as f64,
+            );
+            format!("{{ position = [{x}, {y}, {}] }}", r - depth)
+        })
+        .collect();
+    let sim = scene(
+        "1e-6",
+        0.0,
+        "",
+        &material("m", 2500.0, young, nu, 0.5, 0.5),
+        &format!(
+            r#"[shapes.ball]
+kind = "sphere"
+radius = {r}
+[[wall]]
+name = "floor"
+material = "m"
+geometry = {{ kind = "box", min = [-0.05, -0.05, 0.0], max = [0.05, 0.05, 0.1], open_top = true }}
+[[particles]]
+kind = "list"
+shape = "ball"
+material = "m"
+bodies = [{}]
+"#,
+            bodies.join(", ")
+        ),
+    );
+    assert_eq!(sim.stats().contacts, 49);
+    let e_eff = young / (2.0 * (1.0 - nu * nu));
+    let hertz = 4.0 / 3.0 * e_eff * r.sqrt() * depth.powf(1.5);
+    for (k, f) in sim.world().particles.force.iter().enumerate() {
+        assert!(f.x == 0.0 && f.y == 0.0, "sphere {k}: {f:?}");
+        assert!(
+            (f.z / hertz - 1.0).abs() < 1e-12,
+            "sphere {k}: {} N, Hertz {hertz} N",
+            f.z
+        );
+    }
+}
+
 /// The same impact integrated apart from the engine: the law's equation of motion
 /// `m δ'' = −4/3 E* √R δ^{3/2} − γ_n δ'`, `γ_n = −2√(5/6) β √(2 E* √(R δ) m)`, with
 /// the force kept non-negative, by RK4 at a thousandth of the engine's step.

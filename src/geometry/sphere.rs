@@ -172,6 +172,53 @@ pub fn closest_point_on_triangle(
     )
 }
 
+/// The in-plane normals of triangle `t`'s edges, each pointing into the triangle:
+/// `n × (t[k+1] − t[k])` for its unit normal `n` (`wall::facet_normal`, with `t`
+/// counter-clockwise about it). A point `p` projects into the triangle (an edge
+/// counting as inside) where `eₖ · (p − t[k]) ≥ 0` for all three.
+pub fn inward_edge_normals(t: &[Point3<Real>; 3], n: &Vector3<Real>) -> [Vector3<Real>; 3] {
+    [0, 1, 2].map(|k| n.cross(&(t[(k + 1) % 3] - t[k])))
+}
+
+/// Contact of a sphere (radius `r`, centre `c`) with the face of triangle `t` (unit
+/// normal `n`, inward edge normals `edges`: [`inward_edge_normals`]), the centre
+/// `height = n · (c − t[0])` above the triangle's plane: where the centre projects
+/// into the triangle, the plane's contact (no point of the plane is nearer), found
+/// without the closest-point search. `None` where it projects outside (the closest
+/// point lies on an edge or a vertex: [`sphere_triangle`]) or the sphere does not
+/// reach below `height` (`height ≥ r`).
+///
+/// The contact is [`sphere_triangle`]'s (normal `n`, depth `r − height`) to
+/// round-off; a caller that merges the facets of a flat patch takes it as the
+/// patch's contact, which no facet's edge or vertex contact can beat.
+#[inline]
+pub fn sphere_on_face(
+    t: &[Point3<Real>; 3],
+    n: &Vector3<Real>,
+    edges: &[Vector3<Real>; 3],
+    c: &Point3<Real>,
+    r: Real,
+    height: Real,
+) -> Option<SphereContact> {
+    // One branch for the three sides: which side a centre lies on is a coin toss
+    // near a shared edge.
+    let inside = (edges[0].dot(&(c - t[0])) >= 0.0)
+        & (edges[1].dot(&(c - t[1])) >= 0.0)
+        & (edges[2].dot(&(c - t[2])) >= 0.0);
+    if !inside || !(height < r) {
+        return None;
+    }
+    let depth = r - height;
+    let projection = c - n * height;
+    Some(SphereContact {
+        depth,
+        normal: *n,
+        point: projection - n * (0.5 * depth),
+        volume: cap_volume(r, depth),
+        area: cap_area(r, depth),
+    })
+}
+
 /// Contact of a sphere (radius `r`, centre `c`) with the triangle `t` (two-sided), and
 /// the triangle feature touched. The normal points from the triangle to the sphere.
 ///

@@ -6,7 +6,7 @@ use nalgebra::{Isometry3, Point3, Vector3};
 use crate::Real;
 use crate::geometry::Shape;
 use crate::geometry::overlap::{OverlapCache, overlap_cached};
-use crate::geometry::sphere::{sphere_polyhedron, sphere_sphere, sphere_triangle};
+use crate::geometry::sphere::{SphereContact, sphere_polyhedron, sphere_sphere, sphere_triangle};
 use crate::geometry::wall::polyhedron_triangle;
 use crate::world::World;
 
@@ -22,6 +22,22 @@ pub(super) struct ContactGeometry {
     /// where the kernel provides it (polyhedra): the elastic torque then derives from
     /// the same potential as the force.
     pub rotation_gradient: Option<Vector3<Real>>,
+}
+
+impl From<SphereContact> for ContactGeometry {
+    /// A sphere's contact given in world coordinates: a sphere's has no rotation
+    /// gradient (its point lies on the line through the centre).
+    #[inline]
+    fn from(c: SphereContact) -> Self {
+        ContactGeometry {
+            volume: c.volume,
+            area: c.area,
+            depth: c.depth,
+            normal: c.normal,
+            point: c.point,
+            rotation_gradient: None,
+        }
+    }
 }
 
 /// The pose of particle `k`.
@@ -118,14 +134,7 @@ pub(super) fn facet_geometry(
         }
         Shape::Sphere(s) => {
             let centre = Point3::from(pose.translation.vector);
-            sphere_triangle(tri, &centre, s.radius).map(|(c, _)| ContactGeometry {
-                volume: c.volume,
-                area: c.area,
-                depth: c.depth,
-                normal: c.normal,
-                point: c.point,
-                rotation_gradient: None,
-            })
+            sphere_triangle(tri, &centre, s.radius).map(|(c, _)| c.into())
         }
     }
 }

@@ -13,7 +13,8 @@ pub(super) enum Merge {
     /// Polyhedra: the facets' prisms tile the patch; their volumes, area vectors and
     /// rotation gradients add.
     Sum,
-    /// Spheres: the deepest facet of a flat patch is the plane contact.
+    /// Spheres: the deepest facet of a flat patch is the plane contact (a facet the
+    /// centre projects into gives it at once: [`PatchSet::add_face`]).
     Deepest,
 }
 
@@ -49,11 +50,22 @@ impl FacetPlane {
 /// between uses: after the first few steps assembling allocates nothing.
 #[derive(Clone, Debug, Default)]
 pub(super) struct PatchSet {
-    /// Plane key and summed geometry of each patch in use.
-    patches: Vec<([i64; 4], ContactGeometry)>,
+    /// The patches in use, in the order they were opened.
+    patches: Vec<Patch>,
     /// Facets of each patch with their shares of the overlap (volumes); entries past
     /// `patches.len()` are spare buffers.
     shares: Vec<Vec<(u32, Real)>>,
+}
+
+/// One patch being assembled.
+#[derive(Clone, Copy, Debug)]
+struct Patch {
+    key: [i64; 4],
+    /// The merged contact.
+    geometry: ContactGeometry,
+    /// Whether `geometry` is a sphere's contact with the plane, found on a facet
+    /// the centre projects into: no other facet of the plane can change it.
+    face: bool,
 }
 
 impl PatchSet {
@@ -62,20 +74,36 @@ impl PatchSet {
         self.patches.clear();
     }
 
+    /// The index of the patch of plane `key`, if it is open.
+    #[inline]
+    fn find(&self, key: &[i64; 4]) -> Option<usize> {
+        self.patches.iter().position(|p| p.key == *key)
+    }
+
+    /// Opens the patch of plane `key` with facet `f`'s contact `g`.
+    #[inline]
+    fn open(&mut self, key: [i64; 4], f: u32, g: ContactGeometry, face: bool) {
+        let k = self.patches.len();
+        self.patches.push(Patch {
+            key,
+            geometry: g,
+            face,
+        });
+        if self.shares.len() == k {
+            self.shares.push(Vec::new());
+        }
+        self.shares[k].clear();
+        self.shares[k].push((f, g.volume));
+    }
+
     /// Adds facet `f`'s contact `g` to the patch of plane `key`.
     #[inline]
     pub(super) fn add(&mut self, key: [i64; 4], f: u32, g: ContactGeometry, merge: Merge) {
-        let Some(k) = self.patches.iter().position(|(pk, _)| *pk == key) else {
-            let k = self.patches.len();
-            self.patches.push((key, g));
-            if self.shares.len() == k {
-                self.shares.push(Vec::new());
-            }
-            self.shares[k].clear();
-            self.shares[k].push((f, g.volume));
+        let Some(k) = self.find(&key) else {
+            self.open(key, f, g, false);
             return;
         };
-        let (acc, shares) = (&mut self.patches[k].1, &mut self.shares[k]);
+        let (acc, shares) = (&mut self.patches[k].geometry, &mut self.shares[k]);
         match merge {
             Merge::Sum => {
                 let v = acc.volume + g.volume;
@@ -102,6 +130,29 @@ impl PatchSet {
         }
     }
 
+    /// Whether the patch of plane `key` holds a sphere's face contact
+    /// ([`Self::add_face`]): its other facets need not be looked at.
+    #[inline]
+    pub(super) fn has_face(&self, key: &[i64; 4]) -> bool {
+        self.patches.iter().any(|p| p.face && p.key == *key)
+    }
+
+    /// Makes facet `f`'s face contact `g` of a sphere (its centre projects into the
+    /// facet: `geometry::sphere::sphere_on_face`) the contact of the patch of plane
+    /// `key`: the plane's contact, which the edge and vertex contacts of the
+    /// patch's other facets merely approach ([`Merge::Deepest`] to round-off).
+    #[inline]
+    pub(super) fn add_face(&mut self, key: [i64; 4], f: u32, g: ContactGeometry) {
+        let Some(k) = self.find(&key) else {
+            self.open(key, f, g, true);
+            return;
+        };
+        self.patches[k].geometry = g;
+        self.patches[k].face = true;
+        self.shares[k].clear();
+        self.shares[k].push((f, 1.0));
+    }
+
     /// The patches in the order they were opened: key, geometry, facet shares.
     pub(super) fn iter(
         &self,
@@ -109,6 +160,6 @@ impl PatchSet {
         self.patches
             .iter()
             .zip(&self.shares)
-            .map(|((key, g), shares)| (*key, g, shares.as_slice()))
+            .map(|(p, shares)| (p.key, &p.geometry, shares.as_slice()))
     }
 }

@@ -27,6 +27,7 @@ use crate::engine::backend::WallKey;
 use crate::engine::laws::ContactLaws;
 use crate::engine::neighbours::NeighbourList;
 use crate::geometry::Shape;
+use crate::geometry::sphere::{inward_edge_normals, sphere_on_face};
 use crate::geometry::wall::facet_normal;
 use crate::world::{Wall, World};
 
@@ -83,6 +84,9 @@ struct PlacedFacets {
     pose: Option<Isometry3<Real>>,
     triangles: Vec<[Point3<Real>; 3]>,
     normals: Vec<Vector3<Real>>,
+    /// The triangles' inward edge normals (`geometry::sphere::inward_edge_normals`):
+    /// whether a sphere's centre projects into a facet.
+    edges: Vec<[Vector3<Real>; 3]>,
     planes: Vec<FacetPlane>,
 }
 
@@ -98,6 +102,10 @@ impl PlacedFacets {
             .extend((0..wall.triangles.len()).map(|f| wall.facet_world(f)));
         self.normals.clear();
         self.normals.extend(self.triangles.iter().map(facet_normal));
+        self.edges.clear();
+        (self.edges).extend(
+            (self.triangles.iter().zip(&self.normals)).map(|(t, n)| inward_edge_normals(t, n)),
+        );
         self.planes.clear();
         (self.planes).extend(
             (self.triangles.iter().zip(&self.normals)).map(|(t, n)| FacetPlane::new(n, &t[0])),
@@ -293,11 +301,12 @@ fn particle_contacts(
             continue;
         }
         chunk.patches.clear();
+        let placed = &placed[w];
         for &f in facets {
             let (tri, n, plane) = (
-                &placed[w].triangles[f as usize],
-                &placed[w].normals[f as usize],
-                &placed[w].planes[f as usize],
+                &placed.triangles[f as usize],
+                &placed.normals[f as usize],
+                &placed.planes[f as usize],
             );
             // Walls are one-sided: a particle whose centroid is behind a facet's plane
             // has passed it (or the mesh faces the wrong way) and is not pushed back
@@ -308,8 +317,22 @@ fn particle_contacts(
             if !(0.0..=radius).contains(&height) {
                 continue;
             }
+            let key = plane.key(radius);
+            if let Shape::Sphere(s) = &t.shape {
+                // A sphere over a flat patch: the plane's contact, from the first
+                // facet the centre projects into; the patch's other facets are not
+                // searched for their closest points.
+                if chunk.patches.has_face(&key) {
+                    continue;
+                }
+                let edges = &placed.edges[f as usize];
+                if let Some(c) = sphere_on_face(tri, n, edges, &p.position[i], s.radius, height) {
+                    chunk.patches.add_face(key, f, c.into());
+                    continue;
+                }
+            }
             if let Some(g) = facet_geometry(&t.shape, &pose, tri) {
-                chunk.patches.add(plane.key(radius), f, g, merge);
+                chunk.patches.add(key, f, g, merge);
             }
         }
         let law = laws.wall(p.body_type[i], wall.material);
