@@ -23,49 +23,42 @@ struct FacetContact {
     Vec3 normal, point;
 };
 
-static __device__ __forceinline__ bool sphere_facet(const double* t, Vec3 centre, double r,
-                                                    FacetContact* out) {
+// A sphere's contact with one facet (unit normal n, the centre `height` above its
+// plane), and whether it is the face's. Where the centre projects into the facet,
+// the plane's contact, without the closest-point search (geometry/sphere.rs
+// `sphere_on_face`; the edges' inward normals n × (b − a) are the ones
+// engine/cpu/walls.rs places once per facet); elsewhere the closest point's, as
+// geometry/sphere.rs `sphere_triangle` and engine/cpu/dispatch.rs give it.
+static __device__ __forceinline__ bool sphere_facet(const double* t, Vec3 n, Vec3 centre,
+                                                    double r, double height,
+                                                    FacetContact* out, bool* face) {
     Vec3 a = load3(t, 0), b = load3(t, 1), c = load3(t, 2);
-    Vec3 q = closest_on_triangle(a, b, c, centre);
-    Vec3 offset = sub(centre, q);
-    double distance = norm(offset);
-    if (distance >= r) {
-        return false;
-    }
-    Vec3 normal;
-    if (distance > 0.0) {
-        normal = divide(offset, distance);
+    *face = (dot(cross(n, sub(b, a)), sub(centre, a)) >= 0.0) &
+            (dot(cross(n, sub(c, b)), sub(centre, b)) >= 0.0) &
+            (dot(cross(n, sub(a, c)), sub(centre, c)) >= 0.0) & (height < r);
+    Vec3 q, normal;
+    double depth;
+    if (*face) {
+        depth = r - height;
+        normal = n;
+        q = sub(centre, scale(n, height));
     } else {
-        normal = normalize(cross(sub(b, a), sub(c, a)));
+        q = closest_on_triangle(a, b, c, centre);
+        Vec3 offset = sub(centre, q);
+        double distance = norm(offset);
+        if (distance >= r) {
+            return false;
+        }
+        if (distance > 0.0) {
+            normal = divide(offset, distance);
+        } else {
+            normal = normalize(cross(sub(b, a), sub(c, a)));
+        }
+        depth = r - distance;
     }
-    double depth = r - distance;
     out->depth = depth;
     out->normal = normal;
     out->point = sub(q, scale(normal, 0.5 * depth));
-    out->volume = cap_volume(r, depth);
-    out->area = cap_area(r, depth);
-    return true;
-}
-
-// A sphere's contact with the face of a facet (unit normal n) its centre projects
-// into, `height` above the facet's plane: the plane's contact, without the
-// closest-point search (geometry/sphere.rs `sphere_on_face`; the edges' inward
-// normals n × (b − a) are the ones engine/cpu/walls.rs places once per facet).
-static __device__ __forceinline__ bool sphere_on_face(const double* t, Vec3 n, Vec3 centre,
-                                                      double r, double height,
-                                                      FacetContact* out) {
-    Vec3 a = load3(t, 0), b = load3(t, 1), c = load3(t, 2);
-    bool inside = (dot(cross(n, sub(b, a)), sub(centre, a)) >= 0.0) &
-                  (dot(cross(n, sub(c, b)), sub(centre, b)) >= 0.0) &
-                  (dot(cross(n, sub(a, c)), sub(centre, c)) >= 0.0);
-    if (!inside || !(height < r)) {
-        return false;
-    }
-    double depth = r - height;
-    Vec3 projection = sub(centre, scale(n, height));
-    out->depth = depth;
-    out->normal = n;
-    out->point = sub(projection, scale(n, 0.5 * depth));
     out->volume = cap_volume(r, depth);
     out->area = cap_area(r, depth);
     return true;
@@ -145,8 +138,8 @@ extern "C" __global__ void sphere_walls(
                 continue;
             }
             FacetContact g;
-            bool face = sphere_on_face(tri, nrm, x, r, height, &g);
-            if (!face && !sphere_facet(tri, x, r, &g)) {
+            bool face;
+            if (!sphere_facet(tri, nrm, x, r, height, &g, &face)) {
                 continue;
             }
             if (p == patches) {
