@@ -371,7 +371,14 @@ fn a_bed_fed_from_above_and_frozen_packs_alike_on_two_ranks() {
     ];
     assert_same_bytes(&one, &two, 7, &files);
     let s = summary(&two);
-    assert_eq!(s["particles"], 240, "0.6 s at 400 per second");
+    // 0.6 s at 400 per second from the first at t = 0: 241 due at the end; a
+    // particle that finds no free place waits for the next step, so the last may
+    // not be in yet (one of the two, depending on where the bed left room).
+    let particles = s["particles"].as_u64().unwrap();
+    assert!(
+        (240..=241).contains(&particles),
+        "{particles} particles: 0.6 s at 400 per second"
+    );
     assert!(s["frozen"].as_u64().unwrap() > 100, "{}", s["frozen"]);
     assert_eq!(s["frozen"], summary(&one)["frozen"]);
     let _ = std::fs::remove_dir_all(&dir);
