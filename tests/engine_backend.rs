@@ -191,16 +191,21 @@ fn the_first_non_finite_particle_is_named() {
     let mut sim = Simulation::new(&scene);
     let _ = sim.advance_to(1e-3, |_, _| ControlFlow::<()>::Continue(()));
     assert_eq!(sim.first_non_finite(), None);
+    // The step looked itself, so the host need not.
+    assert_eq!(sim.backend().stepped_finite(), Some(true));
     let (a, b) = (sim.world().particles.id[40], sim.world().particles.id[70]);
     sim.edit_world(|w| {
         w.particles.velocity[70].y = f64::NAN;
         w.particles.position[40].z = f64::INFINITY;
     });
+    // An edit since the step: the step's look no longer holds, the host looks.
+    assert_eq!(sim.backend().stepped_finite(), None);
     assert_eq!(sim.first_non_finite(), Some(a));
     // Stepping a blown-up state answers (non-finite values), never panics or hangs:
     // the broad phase bins a non-finite particle into a corner cell.
     let t = sim.time();
     let _ = sim.advance_to(t + 1e-4, |_, _| ControlFlow::<()>::Continue(()));
+    assert_eq!(sim.backend().stepped_finite(), Some(false));
     assert_eq!(sim.first_non_finite(), Some(a));
     sim.edit_world(|w| w.particles.position[40].z = 0.01);
     assert_eq!(sim.first_non_finite(), Some(b));

@@ -96,6 +96,16 @@ pub trait Backend: Send + fmt::Debug {
     /// date with the particles, in [`sync_to_host`](Backend::sync_to_host).
     fn touching(&self) -> &[bool];
 
+    /// Whether the last step left every owned particle's position, velocity,
+    /// angular momentum, force and torque finite, as the step's own passes over the
+    /// particles found: `Some(true)` spares the host a look at every particle after
+    /// each step. `None` where the backend does not know, or since the host world
+    /// changed otherwise (any call below); `Some(false)` may be a false alarm. Either
+    /// way the host looks itself ([`crate::world::Particles::all_finite`]).
+    fn stepped_finite(&self) -> Option<bool> {
+        None
+    }
+
     /// Particles `added` were appended to the host world (state and forces set).
     fn particles_added(&mut self, world: &World, added: Range<usize>);
 

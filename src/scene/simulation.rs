@@ -582,7 +582,7 @@ impl Simulation {
             return w.figures.non_finite;
         }
         let p = &self.world.particles;
-        if p.all_finite() {
+        if self.backend.stepped_finite() == Some(true) || p.all_finite() {
             return None;
         }
         (0..p.owned()).find(|&i| !p.is_finite(i)).map(|i| p.id[i])

@@ -2,6 +2,7 @@
 //! copies after them.
 
 use std::collections::HashMap;
+use std::ops::Range;
 
 use nalgebra::{Point3, UnitQuaternion, Vector3};
 
@@ -83,6 +84,12 @@ impl Particles {
     /// sweep, cheap enough for every step (`x · 0` is 0 for a finite `x` and NaN
     /// otherwise, and a sum holding a NaN is NaN).
     pub fn all_finite(&self) -> bool {
+        self.all_finite_in(0..self.owned())
+    }
+
+    /// Whether every particle of `range` (owned ones) [`is_finite`](Self::is_finite),
+    /// as [`all_finite`](Self::all_finite) looks.
+    pub fn all_finite_in(&self, range: Range<usize>) -> bool {
         // Four running sums taken in turn, so that four chains of adds overlap instead
         // of each add waiting on the one before.
         fn zeros<T>(v: &[T], coords: impl Fn(&T) -> &Vector3<Real>) -> Real {
@@ -98,15 +105,15 @@ impl Particles {
             }
             sums.iter().map(|s| s.x + s.y + s.z).sum()
         }
-        let n = self.owned();
         fn vector(x: &Vector3<Real>) -> &Vector3<Real> {
             x
         }
-        (zeros(&self.position[..n], |x: &Point3<Real>| &x.coords)
-            + zeros(&self.velocity[..n], vector)
-            + zeros(&self.angular_momentum[..n], vector)
-            + zeros(&self.force[..n], vector)
-            + zeros(&self.torque[..n], vector))
+        let r = range;
+        (zeros(&self.position[r.clone()], |x: &Point3<Real>| &x.coords)
+            + zeros(&self.velocity[r.clone()], vector)
+            + zeros(&self.angular_momentum[r.clone()], vector)
+            + zeros(&self.force[r.clone()], vector)
+            + zeros(&self.torque[r], vector))
             == 0.0
     }
 

@@ -82,6 +82,9 @@ pub struct CpuBackend {
     work: Workspace,
     stats: StepStats,
     times: StageTimes,
+    /// Whether the last step left every owned particle finite
+    /// ([`Backend::stepped_finite`]); `None` once anything else changed the world.
+    finite: Option<bool>,
 }
 
 impl CpuBackend {
@@ -116,15 +119,19 @@ impl CpuBackend {
 
     /// The closing half kick of the owned particles.
     pub fn close(&mut self, world: &mut World, dt: Real) {
-        self.times.time(Stage::Integrate, || {
-            motion::closing_kick(world, dt, &mut self.work.type_steps)
-        });
+        self.finite = Some(self.times.time(Stage::Integrate, || {
+            motion::closing_kick(world, dt, &mut self.work.type_steps);
+            motion::all_finite(world)
+        }));
     }
 
     /// Forces and torques of the current positions and velocities, stage by stage.
     /// A step's evaluation (`stepped`) also counts the fluid's exchange over `dt`;
     /// the one of `initialise` only sets the forces.
     fn evaluate_forces(&mut self, world: &mut World, dt: Real, stepped: bool) {
+        if !stepped {
+            self.finite = None;
+        }
         let Self {
             params,
             list,
@@ -134,6 +141,7 @@ impl CpuBackend {
             work,
             stats,
             times,
+            finite: _,
         } = self;
         times.time(Stage::Laws, || {
             if laws.prepare(world, params.regularisation_length, params.round_law) {
@@ -248,18 +256,29 @@ impl Backend for CpuBackend {
         &self.work.touching
     }
 
+    fn stepped_finite(&self) -> Option<bool> {
+        self.finite
+    }
+
     /// The list sees new ids and rebuilds itself at the next step.
-    fn particles_added(&mut self, _world: &World, _added: Range<usize>) {}
+    fn particles_added(&mut self, _world: &World, _added: Range<usize>) {
+        self.finite = None;
+    }
 
     /// Frozen pairs drop out of the force loop, not out of the candidate lists: no
     /// rebuild is needed.
-    fn particles_frozen(&mut self, _world: &World, _frozen: &[usize]) {}
+    fn particles_frozen(&mut self, _world: &World, _frozen: &[usize]) {
+        self.finite = None;
+    }
 
     fn particles_removed(&mut self, _world: &World) {
         self.list.invalidate();
+        self.finite = None;
     }
 
-    fn velocities_set(&mut self, _world: &World) {}
+    fn velocities_set(&mut self, _world: &World) {
+        self.finite = None;
+    }
 
     /// The lists are checked against the walls' frames every step.
     fn walls_moved(&mut self, _world: &World) {}
@@ -269,6 +288,7 @@ impl Backend for CpuBackend {
 
     fn world_changed(&mut self, _world: &World) {
         self.list.invalidate();
+        self.finite = None;
     }
 
     fn contact_history(&self) -> ContactHistory {
@@ -277,6 +297,7 @@ impl Backend for CpuBackend {
 
     fn restore(&mut self, _world: &World, history: ContactHistory, stats: StepStats) {
         self.contacts.set_history(history, &mut self.list);
+        self.finite = None;
         self.stats = StepStats {
             list_builds: self.stats.list_builds,
             ..stats

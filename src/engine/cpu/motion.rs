@@ -114,3 +114,20 @@ pub(crate) fn closing_kick(world: &mut World, dt: Real, steps: &mut TypeSteps) {
             *l += t * (0.5 * dt);
         });
 }
+
+/// Whether every owned particle's position, velocity, angular momentum, force and
+/// torque are finite, looked at in chunks side by side.
+///
+/// Why here, after the closing kick, and not by the host after the step: on two
+/// threads the host's serial look read every line that the other core had just
+/// written, and that core then fetched them back for its half of the next kick (the
+/// settled bed of 5000 spheres: the integration stage 73–95 µs a step against 63–66
+/// µs without the look, 2026-12-07). The chunks here fall to the threads about as
+/// the kick's particles did.
+pub(crate) fn all_finite(world: &World) -> bool {
+    let p = &world.particles;
+    let n = p.owned();
+    (0..n.div_ceil(PARTICLES_PER_TASK))
+        .into_par_iter()
+        .all(|c| p.all_finite_in(c * PARTICLES_PER_TASK..n.min((c + 1) * PARTICLES_PER_TASK)))
+}
