@@ -64,6 +64,19 @@ static __device__ __forceinline__ double spring_energy(Spring s) {
     return 0.5 * s.stiffness * norm_squared(s.spring);
 }
 
+// The factor that brings a spring of squared length `held`, cut by `along` the new
+// normal, back to its length (contact/tangential.rs): the series of
+// (1 - e)^(-1/2) to e^2 where the normal barely turned, the square root elsewhere.
+static __device__ __forceinline__ double length_kept(double along_squared, double held,
+                                                     Vec3 projected) {
+    if (along_squared <= 1e-6 * held) {
+        double turn = along_squared / held;
+        return 1.0 + turn * (0.5 + 0.375 * turn);
+    }
+    double p = norm_squared(projected);
+    return p > 0.0 ? sqrt(held / p) : 1.0;
+}
+
 // Cundall–Strack friction (contact/tangential.rs): the force on body 2, the spring
 // kept in *kept.
 static __device__ __forceinline__ Vec3 tangential_force(Spring history, Vec3 normal,
@@ -71,13 +84,14 @@ static __device__ __forceinline__ Vec3 tangential_force(Spring history, Vec3 nor
                                                         double stiffness, double damping,
                                                         double limit, Spring* kept) {
     Vec3 previous = history.spring;
-    Vec3 spring = sub(previous, scale(normal, dot(normal, previous)));
-    double projected = norm_squared(spring);
-    if (projected > 0.0) {
+    double along = dot(normal, previous);
+    Vec3 spring = sub(previous, scale(normal, along));
+    double held = norm_squared(previous);
+    if (held > 0.0) {
         double keep = history.stiffness > 0.0 && stiffness > history.stiffness
                           ? history.stiffness / stiffness
                           : 1.0;
-        spring = scale(spring, keep * sqrt(norm_squared(previous) / projected));
+        spring = scale(spring, keep * length_kept(along * along, held, spring));
     }
     Vec3 vt = sub(relative_velocity, scale(normal, dot(normal, relative_velocity)));
     spring = add(spring, scale(vt, dt));

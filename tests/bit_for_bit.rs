@@ -32,7 +32,7 @@ const CASES: [Case; 3] = [
             0x9e67ff0815da3557,
             0xd6fa5b7a1076ff8d,
             0x22fa1b300583c2c0,
-            0xa8288e3d0c2761fb,
+            0x96b623282b2b86c6,
         ],
     },
     Case {
@@ -43,7 +43,7 @@ const CASES: [Case; 3] = [
             0x17ed34423bde0539,
             0xb65e1ed59af58ef2,
             0xee638a32aac71c74,
-            0x6de701ba6a07fb4a,
+            0xa4f0293c9829bd73,
         ],
     },
     Case {
@@ -54,7 +54,7 @@ const CASES: [Case; 3] = [
             0xfc1c6885498302df,
             0xefc9884127a25b85,
             0x660383da9a42c070,
-            0x094a45e3aec803bd,
+            0x897c43a7c61aca1d,
         ],
     },
 ];
