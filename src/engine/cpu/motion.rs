@@ -4,7 +4,7 @@
 use rayon::prelude::*;
 
 use crate::Real;
-use crate::engine::integrate::{RotationState, free_rotation, half_kick, turn_isotropic};
+use crate::engine::integrate::{RotationState, free_rotation, half_kick, turned_isotropic};
 use crate::geometry::is_isotropic;
 use crate::world::{BodyType, World};
 
@@ -18,7 +18,7 @@ const PARTICLES_PER_TASK: usize = 256;
 struct TypeStep {
     /// `h / (2 m)`: a half kick's velocity change per newton.
     kick: Real,
-    /// `h / (2 I)` of an isotropic body ([`turn_isotropic`]); `None` for another.
+    /// `h / (2 I)` of an isotropic body ([`turned_isotropic`]); `None` for another.
     turn: Option<Real>,
 }
 
@@ -67,17 +67,24 @@ pub(crate) fn kick_drift(world: &mut World, dt: Real, steps: &mut TypeSteps) -> 
             let step = &steps[kind as usize];
             *v += f * step.kick;
             *x += *v * dt;
-            let mut rot = RotationState {
-                orientation: *q,
-                angular_momentum: *l,
-            };
-            half_kick(&mut rot, t, dt);
+            // The state in the particle's own arrays, not in a `RotationState` on the
+            // stack (see `turned_isotropic`).
             match step.turn {
-                Some(half_step) => turn_isotropic(&mut rot, half_step),
-                None => free_rotation(&mut rot, &types[kind as usize].inertia, dt),
+                Some(half_step) => {
+                    half_kick(l, t, dt);
+                    *q = turned_isotropic(q, l, half_step);
+                }
+                None => {
+                    let mut rot = RotationState {
+                        orientation: *q,
+                        angular_momentum: *l,
+                    };
+                    half_kick(&mut rot.angular_momentum, t, dt);
+                    free_rotation(&mut rot, &types[kind as usize].inertia, dt);
+                    *q = rot.orientation;
+                    *l = rot.angular_momentum;
+                }
             }
-            *q = rot.orientation;
-            *l = rot.angular_momentum;
         });
     n - p.frozen_count()
 }
