@@ -57,6 +57,15 @@ pub(super) struct Parts {
     starts: Vec<usize>,
     /// What each part kept back for after the sweep.
     deferred: Vec<Deferred>,
+    /// The list build and thread count the split and `lowest` were made for.
+    ///
+    /// Why kept between steps: a particle's part depends on the list and the split
+    /// alone, and finding it every step (its first pair through the incident lists)
+    /// took the pass that starts the sums from 8 µs on one thread to 27 µs on two
+    /// (the settled bed of 5000 spheres). The split is weighed anew with each list:
+    /// between builds a bed's contacts change little, and a worse split costs time,
+    /// never bits.
+    made_for: Option<(u64, usize)>,
 }
 
 /// What a part kept back: the results of its pairs with a particle of an earlier
@@ -166,7 +175,12 @@ pub(super) fn pair_contacts_gathered(
     (touching, parts): (&mut Vec<bool>, &mut Parts),
 ) -> ContactTotals {
     let pairs = list.pairs();
-    parts.split(pairs.len(), rayon::current_num_threads(), &state.held);
+    let made_for = Some((list.builds(), rayon::current_num_threads()));
+    let find_parts = parts.made_for != made_for;
+    if find_parts {
+        parts.split(pairs.len(), rayon::current_num_threads(), &state.held);
+        parts.made_for = made_for;
+    }
     if parts.count() == 1 {
         return sweep_alone(world, list, state, (radii, types), laws, touching);
     }
@@ -177,7 +191,12 @@ pub(super) fn pair_contacts_gathered(
     let mut torque = std::mem::take(&mut world.particles.torque);
     let p = &world.particles;
     let start = StartLoads::of(world);
-    start_sums(&start, list, parts, (&mut force, &mut torque, touching));
+    start_sums(
+        &start,
+        (list, find_parts),
+        parts,
+        (&mut force, &mut torque, touching),
+    );
     let sums = SharedSums {
         force: force.as_mut_ptr(),
         torque: torque.as_mut_ptr(),
@@ -249,7 +268,8 @@ pub(super) fn add_deferred(
     totals
 }
 
-/// Sets every particle's sums to its start ([`StartLoads`]) and finds its part.
+/// Sets every particle's sums to its start ([`StartLoads`]) and, if `find_parts`,
+/// finds its part.
 ///
 /// By chunks with a loop over indices: a closure per particle that returned its
 /// start and part as a tuple was called out of line, its result read back from the
@@ -257,7 +277,7 @@ pub(super) fn add_deferred(
 /// the settled bed of 5000 spheres on two threads (27–35 µs now).
 fn start_sums(
     start: &StartLoads,
-    list: &NeighbourList,
+    (list, find_parts): (&NeighbourList, bool),
     parts: &mut Parts,
     (force, torque, touching): (&mut [Vector3<Real>], &mut [Vector3<Real>], &mut [bool]),
 ) {
@@ -277,8 +297,10 @@ fn start_sums(
             for (o, lowest) in lowest.iter_mut().enumerate() {
                 let k = first + o;
                 (force[o], torque[o], touching[o]) = start.of_particle(k);
-                let incident = list.incident(k).first();
-                *lowest = incident.map_or(u32::MAX, |e| part_of.of_pair(e.pair()));
+                if find_parts {
+                    let incident = list.incident(k).first();
+                    *lowest = incident.map_or(u32::MAX, |e| part_of.of_pair(e.pair()));
+                }
             }
         });
     parts.lowest = lowest;
