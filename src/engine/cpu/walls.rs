@@ -29,7 +29,7 @@ use crate::engine::neighbours::NeighbourList;
 use crate::geometry::Shape;
 use crate::geometry::sphere::{inward_edge_normals, sphere_on_face};
 use crate::geometry::wall::facet_normal;
-use crate::world::{Wall, World};
+use crate::world::{BodyType, Wall, World};
 
 /// Particles near walls per chunk of the wall stage. Only the particles with listed
 /// facets (or a patch to let go) are visited, and a particle's wall contacts can
@@ -289,73 +289,41 @@ fn particle_contacts(
     }
     let p = &world.particles;
     let t = &world.body_types[p.body_type[i] as usize];
-    let (radius, sphere) = (types.radius(p.body_type[i]), laws.sphere(p.body_type[i]));
-    let pose = pose_of(world, i);
-    let merge = match t.shape {
-        Shape::Polyhedron(_) => Merge::Sum,
-        Shape::Sphere(_) => Merge::Deepest,
-    };
+    let radius = types.radius(p.body_type[i]);
+    // The angular velocity, once a patch is found: a particle listed near a wall
+    // often touches none of its facets.
+    let mut spin = None;
     for (w, wall) in world.walls.iter().enumerate() {
         let facets = list.facets(i, w);
         if facets.is_empty() {
             continue;
         }
-        chunk.patches.clear();
-        let placed = &placed[w];
-        for &f in facets {
-            let (tri, n, plane) = (
-                &placed.triangles[f as usize],
-                &placed.normals[f as usize],
-                &placed.planes[f as usize],
-            );
-            // Walls are one-sided: a particle whose centroid is behind a facet's plane
-            // has passed it (or the mesh faces the wrong way) and is not pushed back
-            // through from behind, where the half-infinite prism would meet it with
-            // its whole volume at once. A centroid farther from the plane than the
-            // bounding radius keeps the whole body off the facet.
-            let height = n.dot(&(p.position[i] - tri[0]));
-            if !(0.0..=radius).contains(&height) {
-                continue;
-            }
-            let key = plane.key(radius);
-            if let Shape::Sphere(s) = &t.shape {
-                // A sphere over a flat patch: the plane's contact, from the first
-                // facet the centre projects into; the patch's other facets are not
-                // searched for their closest points.
-                if chunk.patches.has_face(&key) {
-                    continue;
-                }
-                let edges = &placed.edges[f as usize];
-                if let Some(c) = sphere_on_face(tri, n, edges, &p.position[i], s.radius, height) {
-                    chunk.patches.add_face(key, f, c.into());
-                    continue;
-                }
-            }
-            if let Some(g) = facet_geometry(&t.shape, &pose, tri) {
-                chunk.patches.add(key, f, g, merge);
-            }
-        }
-        let law = laws.wall(p.body_type[i], wall.material);
-        let spin = world.angular_velocity(i);
+        facet_patches(
+            world,
+            i,
+            (t, radius),
+            facets,
+            &placed[w],
+            &mut chunk.patches,
+        );
         for (key, g, facet_shares) in chunk.patches.iter() {
             if !(g.area > 0.0) || !g.normal.iter().all(|x| x.is_finite()) {
                 continue;
             }
+            let spin = *spin.get_or_insert_with(|| world.angular_velocity(i));
             let wall_key = (p.id[i], w as u32, key);
             let h =
                 (before.iter().find(|e| e.0 == wall_key)).map_or_else(Default::default, |e| e.1);
-            let force = match (round, &t.shape) {
-                (RoundLaw::HertzMindlin { rolling }, Shape::Sphere(s)) => {
-                    let inverse_mass = sphere.map_or_else(
-                        || inverse_mass_at(world, i, &g.point, &g.normal),
-                        |s| s.inverse_mass,
-                    );
+            let force = match (round, &t.shape, laws.sphere(p.body_type[i])) {
+                (RoundLaw::HertzMindlin { rolling }, Shape::Sphere(s), Some(sphere)) => {
+                    // The law's moment of inertia enters the volume law's torques
+                    // alone.
                     let motion = RelativeMotion::of_wall(
                         world,
                         (i, &spin),
                         wall,
                         &g.point,
-                        (inverse_mass, law.inertia),
+                        (sphere.inverse_mass, 0.0),
                     );
                     let law = HertzInputs {
                         materials: laws.materials(t.material, wall.material),
@@ -384,6 +352,62 @@ fn particle_contacts(
                 force,
                 shares: start..chunk.shares.len(),
             });
+        }
+    }
+}
+
+/// Sets `patches` to the patches of particle `i` (body type `t` of bounding radius
+/// `radius`) on the listed `facets` of one wall.
+#[inline]
+fn facet_patches(
+    world: &World,
+    i: usize,
+    (t, radius): (&BodyType, Real),
+    facets: &[u32],
+    placed: &PlacedFacets,
+    patches: &mut PatchSet,
+) {
+    patches.clear();
+    let centre = world.particles.position[i];
+    let merge = match t.shape {
+        Shape::Polyhedron(_) => Merge::Sum,
+        Shape::Sphere(_) => Merge::Deepest,
+    };
+    // The pose, once a facet needs the general test: a sphere whose centre
+    // projects into a facet of each plane it touches needs none.
+    let mut pose = None;
+    for &f in facets {
+        let (tri, n, plane) = (
+            &placed.triangles[f as usize],
+            &placed.normals[f as usize],
+            &placed.planes[f as usize],
+        );
+        // Walls are one-sided: a particle whose centroid is behind a facet's plane
+        // has passed it (or the mesh faces the wrong way) and is not pushed back
+        // through from behind, where the half-infinite prism would meet it with
+        // its whole volume at once. A centroid farther from the plane than the
+        // bounding radius keeps the whole body off the facet.
+        let height = n.dot(&(centre - tri[0]));
+        if !(0.0..=radius).contains(&height) {
+            continue;
+        }
+        let key = plane.key(radius);
+        if let Shape::Sphere(s) = &t.shape {
+            // A sphere over a flat patch: the plane's contact, from the first
+            // facet the centre projects into; the patch's other facets are not
+            // searched for their closest points.
+            if patches.has_face(&key) {
+                continue;
+            }
+            let edges = &placed.edges[f as usize];
+            if let Some(c) = sphere_on_face(tri, n, edges, &centre, s.radius, height) {
+                patches.add_face(key, f, c.into());
+                continue;
+            }
+        }
+        let pose = pose.get_or_insert_with(|| pose_of(world, i));
+        if let Some(g) = facet_geometry(&t.shape, pose, tri) {
+            patches.add(key, f, g, merge);
         }
     }
 }
