@@ -20,6 +20,16 @@ static __device__ __forceinline__ Vec3 cayley_transpose(Vec3 w, Vec3 v) {
     return rotate(conjugate(normalised(Quat{1.0, w.x, w.y, w.z})), v);
 }
 
+// 1 / sqrt(s) by its series about 1 where s is within 1e-6 of it, else by the root
+// (integrate.rs: a turned unit quaternion's squared norm is 1 + |w|^2).
+static __device__ __forceinline__ double reciprocal_root_near_one(double s) {
+    double e = s - 1.0;
+    if (fabs(e) <= 1e-6) {
+        return 1.0 - e * (0.5 - 0.375 * e);
+    }
+    return 1.0 / sqrt(s);
+}
+
 // The torque-free rotation over dt of a body of principal moments `inertia`.
 static __device__ void free_rotation(Quat* q, Vec3* l, Vec3 inertia, double dt) {
     if (l->x == 0.0 && l->y == 0.0 && l->z == 0.0) {
@@ -34,7 +44,7 @@ static __device__ void free_rotation(Quat* q, Vec3* l, Vec3 inertia, double dt) 
         Vec3 w = scale(*l, 0.5 * dt / inertia.x);
         Quat turned = qmul(Quat{0.0, w.x, w.y, w.z}, *q);
         turned = Quat{q->w + turned.w, q->x + turned.x, q->y + turned.y, q->z + turned.z};
-        double s = 1.0 / qnorm(turned);
+        double s = reciprocal_root_near_one(qnorm_squared(turned));
         *q = Quat{turned.w * s, turned.x * s, turned.y * s, turned.z * s};
         return;
     }

@@ -85,8 +85,12 @@ static __device__ __forceinline__ Quat qmul(Quat a, Quat b) {
     };
 }
 
+static __device__ __forceinline__ double qnorm_squared(Quat q) {
+    return (q.x * q.x + q.z * q.z) + (q.y * q.y + q.w * q.w);
+}
+
 static __device__ __forceinline__ double qnorm(Quat q) {
-    return sqrt((q.x * q.x + q.z * q.z) + (q.y * q.y + q.w * q.w));
+    return sqrt(qnorm_squared(q));
 }
 
 // q / |q| (nalgebra's `new_normalize`).

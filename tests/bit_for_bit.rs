@@ -32,7 +32,7 @@ const CASES: [Case; 3] = [
             0x9e67ff0815da3557,
             0xd6fa5b7a1076ff8d,
             0x22fa1b300583c2c0,
-            0x96b623282b2b86c6,
+            0xf2d4509454136c29,
         ],
     },
     Case {
@@ -43,7 +43,7 @@ const CASES: [Case; 3] = [
             0x17ed34423bde0539,
             0xb65e1ed59af58ef2,
             0xee638a32aac71c74,
-            0xa4f0293c9829bd73,
+            0xf9587bee29d2a650,
         ],
     },
     Case {

@@ -140,7 +140,25 @@ pub fn turned_isotropic(
     let w = angular_momentum * half_step;
     let q = orientation.into_inner();
     let turned = q + Quaternion::from_imag(w) * q;
-    UnitQuaternion::new_unchecked(turned * (1.0 / turned.norm()))
+    UnitQuaternion::new_unchecked(turned * reciprocal_root_near_one(turned.norm_squared()))
+}
+
+/// `1 / √s`, by its series about 1 where `s` is within 1e-6 of it, else by the root.
+///
+/// Why: a turned unit quaternion's squared norm is `1 + |w|²` (and the round-off its
+/// orientation carried), and `|w|` is half a step's turn, under a milliradian in
+/// nearly every step; there `1 − e/2 + 3e²/8` (`e = s − 1`) is `1/√s` to `5|e|³/16`,
+/// under 1e-18, so the orientation is normalised as before to round-off. The
+/// square root and the division of every particle's turn took 56 % of the kick of the
+/// settled bed of 5000 spheres (perf, 2026-12-07).
+#[inline(always)]
+pub fn reciprocal_root_near_one(s: Real) -> Real {
+    let e = s - 1.0;
+    if e.abs() <= 1e-6 {
+        1.0 - e * (0.5 - 0.375 * e)
+    } else {
+        1.0 / s.sqrt()
+    }
 }
 
 /// Whether every component of `v` is ±0, tested in one branch (three compares of
@@ -200,6 +218,43 @@ mod tests {
         turn_isotropic(&mut b, 0.5 * 1e-4 / inertia.x);
         assert_eq!(a, b);
         assert_ne!(a.orientation, start.orientation);
+    }
+
+    /// Where the series stands in for the root (within 1e-6 of 1) it is the
+    /// correctly rounded `1/√s` to an ulp, and the branches meet there.
+    #[test]
+    fn the_series_is_the_reciprocal_root_near_one() {
+        let exact = |s: Real| 1.0 / s.sqrt();
+        let ulp = Real::EPSILON;
+        for k in -1000..=1000 {
+            let s = 1.0 + 1e-6 * (k as Real / 1000.0);
+            let (series, root) = (reciprocal_root_near_one(s), exact(s));
+            assert!(
+                (series - root).abs() <= ulp,
+                "s = 1 + {:e}: {series} against {root}",
+                s - 1.0
+            );
+        }
+        for s in [1.0 + 2e-6, 1.0 - 2e-6, 0.25, 4.0] {
+            assert_eq!(reciprocal_root_near_one(s), exact(s));
+        }
+        assert!(reciprocal_root_near_one(Real::NAN).is_nan());
+    }
+
+    /// Turned a million times by small steps, an orientation stays a unit quaternion
+    /// to round-off: the series normalises as the root did, without drift.
+    #[test]
+    fn an_orientation_turned_a_million_times_stays_unit() {
+        let mut q = UnitQuaternion::from_euler_angles(0.3, -0.2, 1.1);
+        let l = Vector3::new(3e-3, -1e-3, 2e-3);
+        for _ in 0..1_000_000 {
+            q = turned_isotropic(&q, &l, 0.05);
+        }
+        assert!(
+            (q.norm() - 1.0).abs() < 4.0 * Real::EPSILON,
+            "|q| - 1 = {:e}",
+            q.norm() - 1.0
+        );
     }
 
     #[test]
