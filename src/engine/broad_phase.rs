@@ -43,11 +43,14 @@ struct GridLevel {
 
 impl GridLevel {
     /// Integer coordinates of the cell holding `p` (clamped into the grid).
+    ///
+    /// The conversion truncates a coordinate already clamped to be positive, which
+    /// is its floor (a call to `floor` per coordinate where the target lacks SSE4.1).
     #[inline]
     fn coords(&self, p: &Point3<Real>, origin: &Vector3<Real>) -> [usize; 3] {
         let mut c = [0; 3];
         for k in 0..3 {
-            let x = ((p[k] - origin[k]) / self.cell).floor();
+            let x = (p[k] - origin[k]) / self.cell;
             c[k] = (x.max(0.0) as usize).min(self.dims[k] - 1);
         }
         c

@@ -30,6 +30,7 @@ pub mod metered_exchange;
 #[cfg(feature = "mpi")]
 pub mod mpi_exchange;
 pub mod neighbours;
+mod pair_sort;
 pub mod params;
 pub mod rank;
 pub mod stats;

@@ -34,6 +34,7 @@ use nalgebra::{Isometry3, Point3};
 use rayon::prelude::*;
 
 use super::broad_phase::BroadPhase;
+use super::pair_sort::PairSort;
 use crate::Real;
 use crate::world::{Particles, World};
 
@@ -79,6 +80,9 @@ pub struct ListAnchors {
 /// Skin as a fraction of the smallest bounding radius when none is set.
 pub const DEFAULT_SKIN: Real = 0.2;
 
+/// Particles per task of the facet lists' build.
+const FACET_CHUNK: usize = 256;
+
 /// The candidate lists of one engine (see the module docs for the invariant).
 #[derive(Clone, Debug, Default)]
 pub struct NeighbourList {
@@ -112,6 +116,11 @@ pub struct NeighbourList {
     /// A saved build to start the next build from, where the particles have not
     /// moved beyond its limits since ([`Self::resume_from`]).
     resumed: Option<ListAnchors>,
+    /// The buffers of the pairs' sort by index.
+    sort: PairSort,
+    /// Whether the pairs ascend by their particles' indices (each pair read smaller
+    /// index first): the particles were stored in the order of their space keys.
+    by_index: bool,
 }
 
 impl NeighbourList {
@@ -124,6 +133,14 @@ impl NeighbourList {
     /// of the two particles (the smaller, then the larger).
     pub fn pairs(&self) -> &[[u32; 2]] {
         &self.pairs
+    }
+
+    /// Whether the pairs, each read smaller index first, ascend, and were found
+    /// among particles of `ids` (index by index): a list built next for the same
+    /// particles in the same order pairs them as this one would, so that a pair's
+    /// history is found by walking the two lists side by side.
+    pub fn ascends_by_index_of(&self, ids: &[u64]) -> bool {
+        self.by_index && self.ids == ids
     }
 
     /// What the last build started from (or the saved build the next one will start
@@ -234,27 +251,36 @@ impl NeighbourList {
 
         self.broad
             .find_pairs(&self.anchors, radii, skin, &mut self.pairs);
-        sort_pairs(&mut self.pairs, p);
+        self.by_index = sort_pairs(&mut self.pairs, p, &mut self.sort);
         self.index_incident(n);
 
+        // Each chunk of particles' facets laid end to end, with where each slot's
+        // end (a list per slot cost an allocation per particle and wall).
         let walls = world.walls.len();
-        let lists: Vec<Vec<u32>> = (0..n * walls)
+        let chunks: Vec<(Vec<u32>, Vec<u32>)> = (0..n.div_ceil(FACET_CHUNK))
             .into_par_iter()
-            .map(|slot| {
-                let (k, w) = (slot / walls, slot % walls);
-                let mut found = Vec::new();
-                world.walls[w]
-                    .grid
-                    .query(&self.wall_anchors[slot], radii[k] + skin, &mut found);
-                found
+            .map(|c| {
+                let (mut facets, mut ends, mut found) = (Vec::new(), Vec::new(), Vec::new());
+                for slot in c * FACET_CHUNK * walls..((c + 1) * FACET_CHUNK).min(n) * walls {
+                    let (k, w) = (slot / walls, slot % walls);
+                    world.walls[w].grid.query(
+                        &self.wall_anchors[slot],
+                        radii[k] + skin,
+                        &mut found,
+                    );
+                    facets.extend_from_slice(&found);
+                    ends.push(facets.len() as u32);
+                }
+                (facets, ends)
             })
             .collect();
         self.facet_starts.clear();
         self.facet_starts.push(0);
         self.facets.clear();
-        for list in lists {
-            self.facets.extend_from_slice(&list);
-            self.facet_starts.push(self.facets.len() as u32);
+        for (facets, ends) in chunks {
+            let base = self.facets.len() as u32;
+            self.facet_starts.extend(ends.iter().map(|&end| base + end));
+            self.facets.extend_from_slice(&facets);
         }
         self.near_walls.clear();
         if walls > 0 {
@@ -356,11 +382,12 @@ pub fn automatic_skin(radii: &[Real]) -> Real {
 /// each so that its first particle has the smaller id (a contact is evaluated from
 /// that side, and its history kept under it, whatever the keys). Where the keys
 /// ascend with the index (particles stored in key order) that is the order of the
-/// indices, and sorted as such.
-fn sort_pairs(pairs: &mut [[u32; 2]], p: &Particles) {
+/// indices, and sorted as such. Returns whether it was.
+fn sort_pairs(pairs: &mut Vec<[u32; 2]>, p: &Particles, sort: &mut PairSort) -> bool {
     let key = |i: u32| p.space_key(i as usize);
-    if (0..p.len()).map(|i| p.space_key(i)).is_sorted() {
-        pairs.par_sort_unstable();
+    let by_index = (0..p.len()).map(|i| p.space_key(i)).is_sorted();
+    if by_index {
+        sort.sort(pairs, p.len());
     } else {
         pairs.par_iter_mut().for_each(|pair| {
             if key(pair[0]) > key(pair[1]) {
@@ -374,6 +401,7 @@ fn sort_pairs(pairs: &mut [[u32; 2]], p: &Particles) {
             pair.swap(0, 1);
         }
     });
+    by_index
 }
 
 #[cfg(test)]
