@@ -83,6 +83,9 @@ pub const DEFAULT_SKIN: Real = 0.2;
 /// Particles per task of the facet lists' build.
 const FACET_CHUNK: usize = 256;
 
+/// Particles per task of the look whether the lists are stale.
+const STALE_CHUNK: usize = 1024;
+
 /// The candidate lists of one engine (see the module docs for the invariant).
 #[derive(Clone, Debug, Default)]
 pub struct NeighbourList {
@@ -224,16 +227,26 @@ impl NeighbourList {
         // does, and the pairs' limit is the stricter: only moved walls are checked.
         let moved = |w: usize| world.walls[w].pose != self.wall_poses[w];
         let any_moved = (0..walls).any(moved);
-        (0..p.len()).into_par_iter().any(|k| {
-            let x = p.position[k];
-            (x - self.anchors[k]).norm_squared() >= pair_limit
-                || any_moved
-                    && world.walls.iter().enumerate().any(|(w, wall)| {
+        let n = p.len();
+        (0..n.div_ceil(STALE_CHUNK)).into_par_iter().any(|c| {
+            let chunk = c * STALE_CHUNK..n.min((c + 1) * STALE_CHUNK);
+            // Without a branch per particle: the displacements are compared in a
+            // fold, and the chunk asks once (one thread's look at the pour of 5000
+            // spheres took 25 µs a step with a branch each, 2026-12-07).
+            let far = (p.position[chunk.clone()].iter())
+                .zip(&self.anchors[chunk.clone()])
+                .fold(false, |far, (x, a)| {
+                    far | ((x - a).norm_squared() >= pair_limit)
+                });
+            far || any_moved
+                && chunk.into_iter().any(|k| {
+                    world.walls.iter().enumerate().any(|(w, wall)| {
                         moved(w) && {
-                            let local = wall.pose.inverse_transform_point(&x);
+                            let local = wall.pose.inverse_transform_point(&p.position[k]);
                             (local - self.wall_anchors[k * walls + w]).norm_squared() >= wall_limit
                         }
                     })
+                })
         })
     }
 

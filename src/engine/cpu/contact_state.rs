@@ -187,7 +187,13 @@ mod tests {
     #[test]
     fn a_pair_keeps_its_history_by_index_whatever_its_orientation() {
         let before = [[0, 3], [2, 1], [1, 4], [2, 3], [4, 3]];
-        let histories = [spring(1.0), spring(2.0), spring(3.0), spring(4.0), spring(5.0)];
+        let histories = [
+            spring(1.0),
+            spring(2.0),
+            spring(3.0),
+            spring(4.0),
+            spring(5.0),
+        ];
         // [0, 3] and [2, 3] left, [0, 1] and [3, 5] came, [1, 2] turned round.
         let pairs = [[0, 1], [1, 2], [1, 4], [4, 3], [3, 5]];
         let mut history = Vec::new();
