@@ -152,7 +152,7 @@ pub fn turned_isotropic(
 /// square root and the division of every particle's turn took 56 % of the kick of the
 /// settled bed of 5000 spheres (perf, 2026-12-07).
 #[inline(always)]
-pub fn reciprocal_root_near_one(s: Real) -> Real {
+fn reciprocal_root_near_one(s: Real) -> Real {
     let e = s - 1.0;
     if e.abs() <= 1e-6 {
         1.0 - e * (0.5 - 0.375 * e)
