@@ -78,11 +78,12 @@ static __device__ __forceinline__ double length_kept(double along_squared, doubl
 }
 
 // Cundall–Strack friction (contact/tangential.rs): the force on body 2, the spring
-// kept in *kept.
+// kept in *kept, whether the contact slides (the cap is active) in *sliding.
 static __device__ __forceinline__ Vec3 tangential_force(Spring history, Vec3 normal,
                                                         Vec3 relative_velocity, double dt,
                                                         double stiffness, double damping,
-                                                        double limit, Spring* kept) {
+                                                        double limit, Spring* kept,
+                                                        bool* sliding) {
     Vec3 previous = history.spring;
     double along = dot(normal, previous);
     Vec3 spring = sub(previous, scale(normal, along));
@@ -97,7 +98,8 @@ static __device__ __forceinline__ Vec3 tangential_force(Spring history, Vec3 nor
     spring = add(spring, scale(vt, dt));
     Vec3 trial = sub(scale(spring, -stiffness), scale(vt, damping));
     double squared = norm_squared(trial);
-    if (squared <= limit * limit || squared == 0.0) {
+    *sliding = !(squared <= limit * limit || squared == 0.0);
+    if (!*sliding) {
         *kept = Spring{spring, stiffness};
         return trial;
     }
@@ -109,6 +111,30 @@ static __device__ __forceinline__ Vec3 tangential_force(Spring history, Vec3 nor
     }
     *kept = Spring{spring, stiffness};
     return force;
+}
+
+// The share of a contact's non-conservative force dotted with its whole force that
+// `dissipated` takes at the step's end velocity (engine/cpu/forces.rs `ahead`): the
+// normal damping's, (N - E) N, and where the contact slides friction's |F_t|^2.
+static __device__ __forceinline__ double dissipation_ahead(double normal, double elastic,
+                                                           Vec3 friction, bool sliding) {
+    double damping = (normal - elastic) * normal;
+    return sliding ? damping + norm_squared(friction) : damping;
+}
+
+// Energy a contact dissipated over a step (engine/cpu/forces.rs `dissipated`): the
+// work of its non-conservative force on body 2 at the half-step relative velocity
+// plus, for the share `ahead`, half a kick of its own force ahead; of the pure
+// torque `resisting` at the relative spin; less what its friction spring stored.
+static __device__ __forceinline__ double contact_dissipation(Vec3 non_conservative,
+                                                             double ahead, Vec3 resisting,
+                                                             Vec3 relative, Vec3 spin,
+                                                             double inverse_mass,
+                                                             Spring before, Spring after,
+                                                             double dt) {
+    double kick = 0.5 * dt * inverse_mass;
+    return -dt * (dot(non_conservative, relative) + kick * ahead + dot(resisting, spin)) -
+           (spring_energy(after) - spring_energy(before));
 }
 
 // What a round contact puts on body 2: force, torque about its centroid, the
@@ -188,8 +214,9 @@ static __device__ RoundContact round_contact(double depth, Vec3 normal, Vec3 lev
     double kt = 8.0 * shear * a;
     double damping_t = damping_n * damping_ratio;
     RoundContact c;
+    bool sliding;
     Vec3 t = tangential_force(before, normal, relative, dt, kt, damping_t,
-                              friction * normal_force, &c.kept);
+                              friction * normal_force, &c.kept, &sliding);
     c.force = add(scale(normal, normal_force), t);
     c.torque = cross(lever, c.force);
     Vec3 resisting = Vec3{0.0, 0.0, 0.0};
@@ -200,12 +227,10 @@ static __device__ RoundContact round_contact(double depth, Vec3 normal, Vec3 lev
         c.torque = add(c.torque, resisting);
     }
     c.energy = 0.4 * elastic * depth + spring_energy(c.kept);
-    // Energy dissipated over the step (engine/cpu/forces.rs `dissipated`): the work
-    // of the force less its elastic normal part at the step's end velocity.
-    Vec3 damping = sub(c.force, scale(normal, elastic));
-    Vec3 moved = add(relative, scale(c.force, 0.5 * dt * inverse_mass));
-    c.dissipated = -dt * (dot(damping, moved) + dot(resisting, spin)) -
-                   (spring_energy(c.kept) - spring_energy(before));
+    c.dissipated = contact_dissipation(sub(c.force, scale(normal, elastic)),
+                                       dissipation_ahead(normal_force, elastic, t, sliding),
+                                       resisting, relative, spin, inverse_mass, before, c.kept,
+                                       dt);
     return c;
 }
 

@@ -46,6 +46,8 @@ static __device__ __forceinline__ double signum(double x) {
 
 struct NormalForce {
     Vec3 force;
+    // The force's size along the normal (>= 0).
+    double magnitude;
     double elastic, energy, exponent;
 };
 
@@ -85,7 +87,8 @@ static __device__ NormalForce volume_normal_force(double volume, double area, do
         }
         magnitude -= damping_force * signum(vn);
     }
-    n.force = scale(normal, fmax(magnitude, 0.0));
+    n.magnitude = fmax(magnitude, 0.0);
+    n.force = scale(normal, n.magnitude);
     return n;
 }
 
@@ -177,7 +180,9 @@ static __device__ VolumeContact volume_contact(const VolumeGeometry& g, const Vo
     double ct = 2.0 * zeta1 * sqrt(effective_mass * kt);
     VolumeContact c;
     double limit = friction * norm(n.force);
-    Vec3 t = tangential_force(before, g.normal, m.velocity, dt, kt, ct, limit, &c.kept);
+    bool sliding;
+    Vec3 t = tangential_force(before, g.normal, m.velocity, dt, kt, ct, limit, &c.kept,
+                              &sliding);
     Vec3 force = add(n.force, t);
     Vec3 rocking = Vec3{0.0, 0.0, 0.0};
     if (g.depth > 0.0) {
@@ -202,10 +207,9 @@ static __device__ VolumeContact volume_contact(const VolumeGeometry& g, const Vo
     c.force = force;
     c.torque = add(damping_torque, moment);
     c.energy = n.energy + spring_energy(c.kept);
-    // engine/cpu/forces.rs, dissipated.
-    Vec3 non_conservative = sub(force, scale(g.normal, n.elastic));
-    Vec3 velocity = add(m.velocity, scale(force, 0.5 * dt * m.inverse_mass));
-    c.dissipated = -dt * (dot(non_conservative, velocity) + dot(damping_torque, m.spin)) -
-                   (spring_energy(c.kept) - spring_energy(before));
+    c.dissipated = contact_dissipation(sub(force, scale(g.normal, n.elastic)),
+                                       dissipation_ahead(n.magnitude, n.elastic, t, sliding),
+                                       damping_torque, m.velocity, m.spin, m.inverse_mass,
+                                       before, c.kept, dt);
     return c;
 }

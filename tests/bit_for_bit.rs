@@ -32,7 +32,7 @@ const CASES: [Case; 3] = [
             0x9e67ff0815da3557,
             0xd6fa5b7a1076ff8d,
             0x22fa1b300583c2c0,
-            0xf2d4509454136c29,
+            0xed9da034cad028d4,
         ],
     },
     Case {
@@ -43,7 +43,7 @@ const CASES: [Case; 3] = [
             0x17ed34423bde0539,
             0xb65e1ed59af58ef2,
             0xee638a32aac71c74,
-            0xf9587bee29d2a650,
+            0x5641d5d98cb625ec,
         ],
     },
     Case {
@@ -54,7 +54,7 @@ const CASES: [Case; 3] = [
             0xfc1c6885498302df,
             0xefc9884127a25b85,
             0x660383da9a42c070,
-            0x897c43a7c61aca1d,
+            0x00bfe3c11f16a1a1,
         ],
     },
 ];

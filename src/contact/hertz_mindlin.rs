@@ -89,6 +89,8 @@ pub struct HertzContact {
 pub struct HertzMindlinForce {
     /// Normal plus tangential force on body 2.
     pub force: Vector3<Real>,
+    /// Whether the contact slides (the Coulomb cap is active).
+    pub sliding: bool,
     /// Magnitude of the normal force (≥ 0).
     pub normal: Real,
     /// Magnitude of its elastic part, `4/3 E* √R* δ^{3/2}` (the rest is damping).
@@ -131,6 +133,7 @@ pub fn hertz_mindlin_force(
     );
     HertzMindlinForce {
         force: c.normal * normal + t.force,
+        sliding: t.sliding,
         normal,
         elastic,
         stiffness,

@@ -91,6 +91,8 @@ impl Regularisation {
 pub struct NormalForce {
     /// Total normal force on body 2 (elastic plus damping, never attractive).
     pub force: Vector3<Real>,
+    /// Its size along the normal (≥ 0).
+    pub magnitude: Real,
     /// Magnitude of the elastic part, `κ A_n V^{1/3}` (or its regularised form).
     pub elastic: Real,
     /// Elastic energy stored in the contact (the potential `U(V)`).
@@ -157,8 +159,10 @@ pub fn normal_force(c: &NormalContact, damping: &DampingTable) -> NormalForce {
         }
         magnitude -= damping_force * vn.signum();
     }
+    let magnitude = magnitude.max(0.0);
     NormalForce {
-        force: c.normal * magnitude.max(0.0),
+        force: c.normal * magnitude,
+        magnitude,
         elastic,
         energy,
         exponent,

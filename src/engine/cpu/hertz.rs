@@ -9,7 +9,7 @@
 
 use nalgebra::Vector3;
 
-use super::forces::{ContactForce, RelativeMotion, dissipated};
+use super::forces::{ContactForce, RelativeMotion, ahead, dissipated};
 use crate::Real;
 use crate::contact::{
     HertzContact, RollingContact, RollingModel, TangentialHistory, hertz_mindlin_force,
@@ -90,7 +90,15 @@ pub(super) fn round_contact_force(
         history: kept,
         energy: f.energy + kept.spring_energy(),
         dissipated: dissipated(
-            (&(f.force - normal * f.elastic), &f.force),
+            (
+                &(f.force - normal * f.elastic),
+                ahead(
+                    f.normal,
+                    f.elastic,
+                    &(f.force - normal * f.normal),
+                    f.sliding,
+                ),
+            ),
             &resisting,
             motion,
             (history, &kept),
