@@ -17,7 +17,12 @@ loop (LIGGGHTS's "Loop time", talus's summary.json), over the pour and the settl
 bed; the ratio talus / LIGGGHTS on one thread; talus's speed-up on two threads.
 
     benches/peers/liggghts_pour.py [--install] [--rounds 2] [--threads 1 2]
+                                   [--liggghts-procs 1 2]
                                    [--steps 50000] [--settled-steps 10000] [--pgo]
+
+--liggghts-procs 1 2 also runs LIGGGHTS on 2 MPI processes (`mpirun -np 2`, the box
+cut across x into one slab per process), interleaved in each round: how far an
+established code scales on the same machine, beside talus's threads.
 
 --pgo also builds talus with scripts/build-pgo.sh (profile-guided) and measures
 that build beside the plain release build, interleaved in each round.
@@ -99,18 +104,24 @@ def write_poses(positions: list, path: Path) -> None:
             f.write(f"{x},{y},{z},1,0,0,0\n")
 
 
-def liggghts(work: Path, steps: int, settled: int) -> dict:
-    """Runs the deck; returns the loop times of the pour and the settled bed."""
+def liggghts(work: Path, steps: int, settled: int, procs: int = 1) -> dict:
+    """Runs the deck on `procs` MPI processes; returns the particle-steps per second
+    of the pour and of the settled bed."""
     deck = (HERE / "pour.in").read_text()
     deck = deck.replace("run 49999", f"run {steps - 1}").replace("run 10000", f"run {settled}")
+    if procs > 1:
+        # Cut the box across x, not along its height (LIGGGHTS's choice for a tall
+        # box): the bed settles in the lowest sixth, which a cut along z leaves to one
+        # process.
+        deck = deck.replace("units           si\n", f"units           si\nprocessors      {procs} 1 1\n")
     (work / "pour.in").write_text(deck)
     env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
-    out = subprocess.run(
-        ["liggghts", "-in", "pour.in", "-var", "dir", str(work), "-var", "stl", str(HERE / "box.stl")],
-        cwd=work, env=env, capture_output=True, text=True, check=True,
-    ).stdout
+    command = ["liggghts", "-in", "pour.in", "-var", "dir", str(work), "-var", "stl", str(HERE / "box.stl")]
+    if procs > 1:
+        command = ["mpirun", "-np", str(procs)] + command
+    out = subprocess.run(command, cwd=work, env=env, capture_output=True, text=True, check=True).stdout
     loops = [(float(t), int(s), int(a)) for t, s, a in
-             re.findall(r"Loop time of ([\d.e+-]+) on 1 procs for (\d+) steps with (\d+) atoms", out)]
+             re.findall(rf"Loop time of ([\d.e+-]+) on {procs} procs for (\d+) steps with (\d+) atoms", out)]
     if len(loops) != 4:
         sys.exit(f"LIGGGHTS printed {len(loops)} loop times, expected 4:\n{out[-3000:]}")
     pour = loops[:3]
@@ -135,6 +146,8 @@ def main() -> None:
     p.add_argument("--install", action="store_true", help="apt-get install liggghts when missing")
     p.add_argument("--rounds", type=int, default=2)
     p.add_argument("--threads", type=int, nargs="+", default=[1, 2])
+    p.add_argument("--liggghts-procs", type=int, nargs="+", default=[1],
+                   help="MPI process counts LIGGGHTS runs on (1 is always run: its dumps start talus)")
     p.add_argument("--steps", type=int, default=50000)
     p.add_argument("--settled-steps", type=int, default=10000)
     p.add_argument("--pgo", action="store_true",
@@ -153,12 +166,16 @@ def main() -> None:
         builds["talus pgo"] = ROOT / "target" / "pgo" / "talus"
     work = Path(tempfile.mkdtemp(prefix="talus-peers-"))
     runs = [(f"{name} {t}", binary, t) for t in args.threads for name, binary in builds.items()]
-    results = {"liggghts": []} | {key: [] for key, _, _ in runs}
+    procs = sorted(set(args.liggghts_procs) - {1})
+    results = ({"liggghts": []} | {f"liggghts {n} procs": [] for n in procs}
+               | {key: [] for key, _, _ in runs})
     contacts = {}
     for round_ in range(args.rounds):
         results["liggghts"].append(liggghts(work, args.steps, args.settled_steps))
         write_poses(last_frame(work / "start.dump"), work / "start.csv")
         write_poses(last_frame(work / "settled.dump"), work / "settled.csv")
+        for n in procs:
+            results[f"liggghts {n} procs"].append(liggghts(work, args.steps, args.settled_steps, n))
         for key, binary, t in runs:
             pour = talus(binary, work, work / "start.csv", args.steps, t, "pour")
             settled = talus(binary, work, work / "settled.csv", args.settled_steps, t, "settled")
@@ -185,6 +202,14 @@ def main() -> None:
             one, two = median[f"{name} 1"], median[f"{name} 2"]
             print(f"{name} 2 threads / 1 thread: pour {two['pour'] / one['pour']:.2f}, "
                   f"settled {two['settled'] / one['settled']:.2f}")
+    for n in procs:
+        m = median[f"liggghts {n} procs"]
+        print(f"LIGGGHTS {n} processes / 1 process: pour {m['pour'] / lig['pour']:.2f}, "
+              f"settled {m['settled'] / lig['settled']:.2f}")
+        if f"talus {n}" in median:
+            t = median[f"talus {n}"]
+            print(f"talus on {n} threads / LIGGGHTS on {n} processes: pour {t['pour'] / m['pour']:.2f}, "
+                  f"settled {t['settled'] / m['settled']:.2f}")
     shutil.rmtree(work, ignore_errors=True)
 
 
