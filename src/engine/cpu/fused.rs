@@ -25,6 +25,7 @@
 //! particles on the boundary between two parts' regions have deferred pairs.
 
 use std::ops::Range;
+use std::time::Instant;
 
 use nalgebra::Vector3;
 use rayon::prelude::*;
@@ -33,6 +34,7 @@ use super::blocks::BLOCK;
 use super::contact_state::ContactState;
 use super::forces::PairResult;
 use super::pairs::{BlockPlans, ContactTotals, PairLaws, StartLoads, evaluate_block};
+use super::part_split::PartSplit;
 use super::prefetch::PairPrefetch;
 use super::type_table::TypeTable;
 use crate::Real;
@@ -40,9 +42,6 @@ use crate::contact::TangentialHistory;
 use crate::engine::neighbours::NeighbourList;
 use crate::geometry::overlap::OverlapCache;
 use crate::world::World;
-
-/// What a pair in contact costs the sweep against a pair apart (a distance).
-const CONTACT_COST: usize = 8;
 
 /// Particles per task of the passes over particles on many threads.
 const PARTICLES_PER_TASK: usize = 1024;
@@ -52,20 +51,16 @@ const PARTICLES_PER_TASK: usize = 1024;
 pub(super) struct Parts {
     /// Each particle's part: the one that holds its first pair (`u32::MAX` for a
     /// particle without pairs).
-    lowest: Vec<u32>,
-    /// The first pair of each part, ascending, and the number of pairs last.
-    starts: Vec<usize>,
-    /// What each part kept back for after the sweep.
-    deferred: Vec<Deferred>,
-    /// The list build and thread count the split and `lowest` were made for.
     ///
     /// Why kept between steps: a particle's part depends on the list and the split
     /// alone, and finding it every step (its first pair through the incident lists)
     /// took the pass that starts the sums from 8 µs on one thread to 27 µs on two
-    /// (the settled bed of 5000 spheres). The split is weighed anew with each list:
-    /// between builds a bed's contacts change little, and a worse split costs time,
-    /// never bits.
-    made_for: Option<(u64, usize)>,
+    /// (the settled bed of 5000 spheres). It is found with each new split.
+    lowest: Vec<u32>,
+    /// Where the parts begin, and when they ended.
+    split: PartSplit,
+    /// What each part kept back for after the sweep.
+    deferred: Vec<Deferred>,
 }
 
 /// What a part kept back: the results of its pairs with a particle of an earlier
@@ -76,6 +71,8 @@ struct Deferred {
     blocks: Vec<ContactTotals>,
     /// The overlap plan of the pairs without one (spheres).
     spare: OverlapCache,
+    /// When the part ended, s after the sweep began.
+    ended: f64,
 }
 
 /// The particles' sums, written by the parts side by side.
@@ -116,53 +113,6 @@ impl SharedSums {
     }
 }
 
-impl Parts {
-    /// Splits `pairs` pairs into `count` runs of whole blocks of about equal work:
-    /// a pair apart costs a distance, a contact about [`CONTACT_COST`] times that, and
-    /// the pairs that held a contact after the last step (`held`, a mask per block)
-    /// are taken for this step's contacts (among polyhedra, the mask of the list's
-    /// build: a guess serves, the split changes the time, never the sums).
-    fn split(&mut self, pairs: usize, count: usize, held: &[u64]) {
-        let blocks = pairs.div_ceil(BLOCK);
-        let count = count.clamp(1, blocks.max(1));
-        self.starts.clear();
-        self.starts.push(0);
-        if count == 1 {
-            // One part: nothing to weigh.
-            self.starts.push(pairs);
-            self.deferred.resize_with(1, Deferred::default);
-            return;
-        }
-        let work = |b: usize| {
-            let len = BLOCK.min(pairs - b * BLOCK);
-            len + CONTACT_COST * held.get(b).map_or(0, |h| h.count_ones() as usize)
-        };
-        let total: usize = (0..blocks).map(work).sum();
-        let mut done = 0;
-        for b in 0..blocks {
-            done += work(b);
-            // Block `b` ends part `m` where the work so far passes its share.
-            let (m, end) = (self.starts.len(), (b + 1) * BLOCK);
-            if m < count && done * count >= total * m && end < pairs {
-                self.starts.push(end);
-            }
-        }
-        self.starts.push(pairs);
-        self.deferred.resize_with(self.count(), Deferred::default);
-    }
-
-    /// The number of parts.
-    fn count(&self) -> usize {
-        self.starts.len() - 1
-    }
-
-    /// The part that holds pair `k`.
-    #[inline]
-    fn of_pair(&self, k: usize) -> u32 {
-        (self.starts[1..].partition_point(|&s| s <= k)) as u32
-    }
-}
-
 /// Sets every particle's force, torque and touching flag to its weight plus its pairs'
 /// contacts, added in pair order (see the module docs), evaluating the pairs in as
 /// many parts as there are threads. Returns the pairs' count and energies.
@@ -175,13 +125,14 @@ pub(super) fn pair_contacts_gathered(
     (touching, parts): (&mut Vec<bool>, &mut Parts),
 ) -> ContactTotals {
     let pairs = list.pairs();
-    let made_for = Some((list.builds(), rayon::current_num_threads()));
-    let find_parts = parts.made_for != made_for;
+    let made_for = (list.builds(), rayon::current_num_threads());
+    let find_parts = parts.split.stale(made_for);
     if find_parts {
-        parts.split(pairs.len(), rayon::current_num_threads(), &state.held);
-        parts.made_for = made_for;
+        parts.split.split(pairs.len(), &state.held, made_for);
+        let count = parts.split.count();
+        parts.deferred.resize_with(count, Deferred::default);
     }
-    if parts.count() == 1 {
+    if parts.split.count() == 1 {
         return sweep_alone(world, list, state, (radii, types), laws, touching);
     }
     let n = world.particles.len();
@@ -219,6 +170,7 @@ pub(super) fn pair_contacts_gathered(
         lowest: &parts.lowest,
         owned: start.owned,
         prefetch,
+        began: Instant::now(),
     };
     let mut totals = ContactTotals::of_candidates(p, pairs);
     let slices = PartSlices {
@@ -229,12 +181,13 @@ pub(super) fn pair_contacts_gathered(
     };
     // Part 0 sums the totals; each later one keeps its terms (see the module docs).
     sweep.parts(
-        (&parts.starts, 0),
+        (parts.split.starts(), 0),
         slices,
         &mut parts.deferred[..],
         sums,
         &mut totals,
     );
+    parts.split.time(parts.deferred.iter().map(|d| d.ended));
     world.particles.force = force;
     world.particles.torque = torque;
     totals
@@ -251,7 +204,11 @@ pub(super) fn add_deferred(
     let pairs = list.pairs();
     let p = &mut world.particles;
     let owned = p.owned();
-    for (m, d) in parts.deferred[..parts.count()].iter().enumerate().skip(1) {
+    for (m, d) in parts.deferred[..parts.split.count()]
+        .iter()
+        .enumerate()
+        .skip(1)
+    {
         for (k, c) in &d.results {
             let [i, j] = pairs[*k as usize].map(|x| x as usize);
             for (particle, first) in [(i, true), (j, false)] {
@@ -299,7 +256,7 @@ fn start_sums(
                 (force[o], torque[o], touching[o]) = start.of_particle(k);
                 if find_parts {
                     let incident = list.incident(k).first();
-                    *lowest = incident.map_or(u32::MAX, |e| part_of.of_pair(e.pair()));
+                    *lowest = incident.map_or(u32::MAX, |e| part_of.split.of_pair(e.pair()));
                 }
             }
         });
@@ -355,6 +312,8 @@ struct Sweep<'a> {
     lowest: &'a [u32],
     owned: usize,
     prefetch: PairPrefetch<'a>,
+    /// When the sweep began.
+    began: Instant,
 }
 
 impl Sweep<'_> {
@@ -404,6 +363,7 @@ impl Sweep<'_> {
             results,
             blocks,
             spare,
+            ended,
         } = deferred;
         let part = m as u32;
         let mut sum = *totals;
@@ -430,6 +390,7 @@ impl Sweep<'_> {
             self.blocks(slices, spare, take, |block| blocks.push(*block));
         }
         *totals = sum;
+        *ended = self.began.elapsed().as_secs_f64();
     }
 
     /// Evaluates the pairs of `slices` block by block, in pair order, handing each

@@ -13,7 +13,8 @@
 //!
 //! The parts: [`motion`] (integration stages), [`pairs`] (a pair's contact, a
 //! block's pairs), [`fused`] (the pair sweep in parts, each pair added to its
-//! particles as it is evaluated), [`blocks`] (blocks of pairs and their masks),
+//! particles as it is evaluated), [`part_split`] (where the parts begin, weighed by
+//! what they took), [`blocks`] (blocks of pairs and their masks),
 //! [`walls`] (wall stage), [`dispatch`] (shape pair → contact geometry), [`patch`]
 //! (coplanar facets merged into one contact), [`relative_motion`] (how the bodies
 //! move at a contact), [`forces`] (geometry → force through the contact laws),
@@ -31,6 +32,7 @@ mod keep_awake;
 pub(crate) mod motion;
 mod overlap_plans;
 mod pairs;
+mod part_split;
 mod patch;
 mod prefetch;
 #[cfg(all(test, feature = "cuda"))]
