@@ -36,6 +36,7 @@ use super::forces::PairResult;
 use super::pairs::{BlockPlans, ContactTotals, PairLaws, StartLoads, evaluate_block};
 use super::part_split::PartSplit;
 use super::prefetch::PairPrefetch;
+use super::shared_sums::SharedSums;
 use super::type_table::TypeTable;
 use crate::Real;
 use crate::contact::TangentialHistory;
@@ -75,44 +76,6 @@ struct Deferred {
     ended: f64,
 }
 
-/// The particles' sums, written by the parts side by side.
-///
-/// Invariant: during the sweep, particle `k`'s sums are written only by part
-/// `lowest[k]` (any other part that meets `k` defers), and nothing reads them.
-#[derive(Clone, Copy)]
-struct SharedSums {
-    force: *mut Vector3<Real>,
-    torque: *mut Vector3<Real>,
-    touching: *mut bool,
-    len: usize,
-}
-
-// SAFETY: the parts write disjoint particles (the invariant above).
-unsafe impl Send for SharedSums {}
-unsafe impl Sync for SharedSums {}
-
-impl SharedSums {
-    /// Adds `c` to particle `k` (the pair's first if `first`).
-    ///
-    /// # Safety
-    /// `k` is below `len`, and no other thread touches particle `k`'s sums meanwhile.
-    #[inline(always)]
-    unsafe fn add(self, k: usize, c: &PairResult, first: bool) {
-        debug_assert!(k < self.len);
-        // SAFETY: in bounds, and this thread's alone (the caller's promise).
-        unsafe {
-            c.add_to(
-                (
-                    &mut *self.force.add(k),
-                    &mut *self.torque.add(k),
-                    &mut *self.touching.add(k),
-                ),
-                first,
-            );
-        }
-    }
-}
-
 /// Sets every particle's force, torque and touching flag to its weight plus its pairs'
 /// contacts, added in pair order (see the module docs), evaluating the pairs in as
 /// many parts as there are threads. Returns the pairs' count and energies.
@@ -148,12 +111,9 @@ pub(super) fn pair_contacts_gathered(
         parts,
         (&mut force, &mut torque, touching),
     );
-    let sums = SharedSums {
-        force: force.as_mut_ptr(),
-        torque: torque.as_mut_ptr(),
-        touching: touching.as_mut_ptr(),
-        len: n,
-    };
+    // Invariant of `SharedSums`: particle `k`'s sums are written by part
+    // `lowest[k]` alone (any other part that meets `k` defers).
+    let sums = SharedSums::over(&mut force, &mut torque, touching);
     let with_plans = state.overlap_plans.len() == pairs.len();
     let (plans, prefetch) = PairPrefetch::over(
         &mut state.overlap_plans,
@@ -325,7 +285,7 @@ impl Sweep<'_> {
         (starts, first): (&[usize], usize),
         slices: PartSlices,
         deferred: &mut [Deferred],
-        sums: SharedSums,
+        sums: SharedSums<'_>,
         totals: &mut ContactTotals,
     ) {
         if let [only] = deferred {
@@ -353,7 +313,7 @@ impl Sweep<'_> {
         &self,
         m: usize,
         slices: PartSlices,
-        sums: SharedSums,
+        sums: SharedSums<'_>,
         totals: &mut ContactTotals,
         deferred: &mut Deferred,
     ) {
@@ -373,8 +333,8 @@ impl Sweep<'_> {
                 // A ghost's sums stay zero.
                 if particle < self.owned {
                     if self.lowest[particle] == part {
-                        // SAFETY: the particle is this part's (`SharedSums`).
-                        unsafe { sums.add(particle, c, first) };
+                        // SAFETY: the particle is this part's (`lowest`).
+                        c.add_to(unsafe { sums.of(particle) }, first);
                     } else {
                         defer = true;
                     }

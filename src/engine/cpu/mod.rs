@@ -38,6 +38,7 @@ mod prefetch;
 #[cfg(all(test, feature = "cuda"))]
 pub(in crate::engine) mod reference;
 mod relative_motion;
+mod shared_sums;
 mod type_table;
 mod wall_history;
 mod walls;
