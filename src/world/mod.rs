@@ -22,6 +22,7 @@ pub use fluid::{
 pub use inlet::{Inlet, Obstacle, PLACEMENT_ATTEMPTS, PlacedParticle, is_free, random_orientation};
 pub use motion::{DriveInput, MotionKey, WallMotion, WallVelocity, advance_pose};
 pub use particles::Particles;
+pub(crate) use particles::all_finite_entries;
 pub use space_order::SpaceOrder;
 
 /// The mass of a set of particles and its first moment `Σ m x`: the moment of

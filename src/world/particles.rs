@@ -90,31 +90,13 @@ impl Particles {
     /// Whether every particle of `range` (owned ones) [`is_finite`](Self::is_finite),
     /// as [`all_finite`](Self::all_finite) looks.
     pub fn all_finite_in(&self, range: Range<usize>) -> bool {
-        // Four running sums taken in turn, so that four chains of adds overlap instead
-        // of each add waiting on the one before.
-        fn zeros<T>(v: &[T], coords: impl Fn(&T) -> &Vector3<Real>) -> Real {
-            let mut sums = [Vector3::zeros(); 4];
-            let chunks = v.chunks_exact(4);
-            for x in chunks.remainder() {
-                sums[0] += coords(x) * 0.0;
-            }
-            for chunk in chunks {
-                for (sum, x) in sums.iter_mut().zip(chunk) {
-                    *sum += coords(x) * 0.0;
-                }
-            }
-            sums.iter().map(|s| s.x + s.y + s.z).sum()
-        }
-        fn vector(x: &Vector3<Real>) -> &Vector3<Real> {
-            x
-        }
         let r = range;
-        (zeros(&self.position[r.clone()], |x: &Point3<Real>| &x.coords)
-            + zeros(&self.velocity[r.clone()], vector)
-            + zeros(&self.angular_momentum[r.clone()], vector)
-            + zeros(&self.force[r.clone()], vector)
-            + zeros(&self.torque[r], vector))
-            == 0.0
+        all_finite_entries(
+            &self.position[r.clone()],
+            &self.velocity[r.clone()],
+            &self.angular_momentum[r.clone()],
+            (&self.force[r.clone()], &self.torque[r]),
+        )
     }
 
     /// Number of owned particles: entries `0..owned()`.
@@ -306,6 +288,41 @@ impl Particles {
     pub fn frozen_count(&self) -> usize {
         self.frozen[..self.owned()].iter().filter(|&&f| f).count()
     }
+}
+
+/// Whether every entry of these slices of the particles' state is finite, as
+/// [`Particles::all_finite`] looks: for a caller that holds some of the arrays
+/// borrowed (the closing kick checks the chunk it kicked).
+pub(crate) fn all_finite_entries(
+    position: &[Point3<Real>],
+    velocity: &[Vector3<Real>],
+    angular_momentum: &[Vector3<Real>],
+    (force, torque): (&[Vector3<Real>], &[Vector3<Real>]),
+) -> bool {
+    // Four running sums taken in turn, so that four chains of adds overlap instead
+    // of each add waiting on the one before.
+    fn zeros<T>(v: &[T], coords: impl Fn(&T) -> &Vector3<Real>) -> Real {
+        let mut sums = [Vector3::zeros(); 4];
+        let chunks = v.chunks_exact(4);
+        for x in chunks.remainder() {
+            sums[0] += coords(x) * 0.0;
+        }
+        for chunk in chunks {
+            for (sum, x) in sums.iter_mut().zip(chunk) {
+                *sum += coords(x) * 0.0;
+            }
+        }
+        sums.iter().map(|s| s.x + s.y + s.z).sum()
+    }
+    fn vector(x: &Vector3<Real>) -> &Vector3<Real> {
+        x
+    }
+    (zeros(position, |x: &Point3<Real>| &x.coords)
+        + zeros(velocity, vector)
+        + zeros(angular_momentum, vector)
+        + zeros(force, vector)
+        + zeros(torque, vector))
+        == 0.0
 }
 
 #[cfg(test)]

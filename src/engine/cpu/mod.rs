@@ -123,8 +123,7 @@ impl CpuBackend {
     /// The closing half kick of the owned particles.
     pub fn close(&mut self, world: &mut World, dt: Real) {
         self.finite = Some(self.times.time(Stage::Integrate, || {
-            motion::closing_kick(world, dt, &mut self.work.type_steps);
-            motion::all_finite(world)
+            motion::closing_kick(world, dt, &mut self.work.type_steps)
         }));
     }
 
