@@ -45,6 +45,8 @@ mod walls;
 
 use std::ops::Range;
 
+use rayon::prelude::*;
+
 use self::contact_state::ContactState;
 use self::type_table::TypeTable;
 use self::walls::{WallInputs, WallWork};
@@ -200,6 +202,9 @@ impl CpuBackend {
     }
 }
 
+/// Particles per task of the radii's refresh.
+const RADII_PER_TASK: usize = 1024;
+
 /// Brings the candidate lists up to date (the radii are refreshed every step: the
 /// body types of the particles may have changed), carrying the pairs' tangential
 /// history over to a new list.
@@ -210,8 +215,15 @@ fn update_list(
     types: &TypeTable,
     radii: &mut Vec<Real>,
 ) {
-    radii.clear();
-    radii.extend(world.particles.body_type.iter().map(|&t| types.radius(t)));
+    let body_type = &world.particles.body_type;
+    radii.resize(body_type.len(), 0.0);
+    (radii.par_chunks_mut(RADII_PER_TASK))
+        .zip(body_type.par_chunks(RADII_PER_TASK))
+        .for_each(|(radii, body_type)| {
+            for (r, &t) in radii.iter_mut().zip(body_type) {
+                *r = types.radius(t);
+            }
+        });
     if list.is_stale(world) {
         contacts.rebuild(list, world, radii);
     }
