@@ -6,7 +6,8 @@
 //! their positions and radii copied in cell order, and the candidate pairs are
 //! written to one flat array: the particles, in cell order, each look through half
 //! the 27-cell stencil about them (every pair of neighbouring cells is searched from
-//! one side only), in parallel over runs of particles whose pairs are appended in
+//! one side only; the cells read as runs along x), in parallel over runs of
+//! particles whose pairs are appended in
 //! order, so the output order does not depend on the number of threads.
 //!
 //! # Wide size distributions
@@ -18,6 +19,8 @@
 //! level (all partners: each cross-level pair is found once, from its smaller member).
 //! The cost per particle stays bounded by the crowding of its own size class, as in
 //! the hierarchical grids of the triangle-based DEM draft.
+
+use std::ops::{Range, RangeInclusive};
 
 use nalgebra::{Point3, Vector3};
 use rayon::prelude::*;
@@ -56,15 +59,24 @@ impl GridLevel {
         c
     }
 
-    /// Positions in `sorted` of the particles in cell `cell`.
-    #[inline]
-    fn members(&self, cell: usize) -> std::ops::Range<usize> {
-        self.starts[cell] as usize..self.starts[cell + 1] as usize
-    }
-
     #[inline]
     fn index(&self, c: [usize; 3]) -> usize {
         (c[2] * self.dims[1] + c[1]) * self.dims[0] + c[0]
+    }
+
+    /// Positions in `sorted` of the particles in the cells `x` of row `(y, z)`:
+    /// neighbours along x are neighbours in the cell order, so a row's cells are
+    /// one run.
+    #[inline]
+    fn row(&self, x: &RangeInclusive<usize>, y: usize, z: usize) -> Range<usize> {
+        let (first, last) = (self.index([*x.start(), y, z]), self.index([*x.end(), y, z]));
+        self.starts[first] as usize..self.starts[last + 1] as usize
+    }
+
+    /// The cells along axis `k` next to and at `c[k]`, within the grid.
+    #[inline]
+    fn around(&self, c: &[usize; 3], k: usize) -> RangeInclusive<usize> {
+        c[k].saturating_sub(1)..=(c[k] + 1).min(self.dims[k] - 1)
     }
 }
 
@@ -109,10 +121,7 @@ impl BroadPhase {
                 .into_par_iter()
                 .with_min_len(PARTICLES_PER_TASK)
                 .fold(Vec::new, |mut out, m| {
-                    let i = grid.sorted[m] as usize;
-                    this.visit_partners(level, m, skin, |j| {
-                        out.push([i.min(j) as u32, i.max(j) as u32]);
-                    });
+                    this.visit_partners(level, m, skin, &mut out);
                     out
                 })
                 .collect();
@@ -196,61 +205,54 @@ impl BroadPhase {
         }
     }
 
-    /// Calls `found(j)` for every partner `j` of the particle at `m` in the cell order
-    /// of level `own` (see [`Self::find_pairs`]): in its own level, the partners in
-    /// its own cell after it and in the 13 neighbour cells of the forward half of the
-    /// stencil (each pair of a level is found once, from one of its two cells); in
-    /// every coarser level, all partners in the 27 cells about it.
-    fn visit_partners(&self, own: usize, m: usize, skin: Real, mut found: impl FnMut(usize)) {
+    /// Appends to `out` the pair `[i, j]` (`i < j`) of the particle `i` at `m` in the
+    /// cell order of level `own` with each of its partners `j` (see
+    /// [`Self::find_pairs`]): in its own level, the partners in its own cell after it
+    /// and in the 13 neighbour cells of the forward half of the stencil (each pair of
+    /// a level is found once, from one of its two cells); in every coarser level, all
+    /// partners in the 27 cells about it.
+    ///
+    /// The cells are read row by row along x, each row one run of the cell order: the
+    /// 13 forward cells in five runs (the rest of its own cell with the next cell
+    /// along x, the row `y + 1`, the three rows of `z + 1`), the 27 in nine. Cell by
+    /// cell, each cell's lookup and bounds cost about as much as the two or three
+    /// particles it holds in a bed of spheres. Each member of a run is written to
+    /// `out`, and the end moves past it only if it is a partner: a branch on that,
+    /// about a coin toss, was mispredicted often. The search of the pour's list
+    /// builds (5000 spheres, one thread) took 1.0–1.1 ms cell by cell, 0.56–0.62 by
+    /// rows, 0.53–0.58 by rows without the branch (2026-12-08).
+    fn visit_partners(&self, own: usize, m: usize, skin: Real, out: &mut Vec<[u32; 2]>) {
         let grid = &self.levels[own];
-        let (p, r) = (grid.positions[m], grid.radii[m]);
-        let mut visit = |grid: &GridLevel, members: std::ops::Range<usize>| {
+        let (p, r, i) = (grid.positions[m], grid.radii[m], grid.sorted[m]);
+        let mut visit = |grid: &GridLevel, members: Range<usize>| {
+            let mut end = out.len();
+            out.resize(end + members.len(), [0; 2]);
             for k in members {
-                let reach = r + grid.radii[k] + skin;
-                if (grid.positions[k] - p).norm_squared() < reach * reach {
-                    found(grid.sorted[k] as usize);
-                }
+                let (j, reach) = (grid.sorted[k], r + grid.radii[k] + skin);
+                out[end] = [i.min(j), i.max(j)];
+                end += usize::from((grid.positions[k] - p).norm_squared() < reach * reach);
             }
+            out.truncate(end);
         };
         let c = grid.coords(&p, &self.origin);
-        let cell = grid.index(c);
-        visit(grid, m + 1..grid.members(cell).end);
-        for [dx, dy, dz] in FORWARD {
-            let neighbour = [c[0] as isize + dx, c[1] as isize + dy, c[2] as isize + dz];
-            if (0..3).all(|k| (0..grid.dims[k] as isize).contains(&neighbour[k])) {
-                let cell = grid.index(neighbour.map(|x| x as usize));
-                visit(grid, grid.members(cell));
+        let xs = grid.around(&c, 0);
+        visit(grid, m + 1..grid.row(&(c[0]..=*xs.end()), c[1], c[2]).end);
+        if c[1] + 1 < grid.dims[1] {
+            visit(grid, grid.row(&xs, c[1] + 1, c[2]));
+        }
+        if c[2] + 1 < grid.dims[2] {
+            for y in grid.around(&c, 1) {
+                visit(grid, grid.row(&xs, y, c[2] + 1));
             }
         }
         for grid in &self.levels[..own] {
             let c = grid.coords(&p, &self.origin);
-            let range = |k: usize| c[k].saturating_sub(1)..=(c[k] + 1).min(grid.dims[k] - 1);
-            for z in range(2) {
-                for y in range(1) {
-                    for x in range(0) {
-                        let cell = grid.index([x, y, z]);
-                        visit(grid, grid.members(cell));
-                    }
+            let xs = grid.around(&c, 0);
+            for z in grid.around(&c, 2) {
+                for y in grid.around(&c, 1) {
+                    visit(grid, grid.row(&xs, y, z));
                 }
             }
         }
     }
 }
-
-/// The 13 neighbour cells of the forward half of a 27-cell stencil: the offsets that
-/// come after `(0, 0, 0)` in the order `(z, y, x)`.
-const FORWARD: [[isize; 3]; 13] = [
-    [1, 0, 0],
-    [-1, 1, 0],
-    [0, 1, 0],
-    [1, 1, 0],
-    [-1, -1, 1],
-    [0, -1, 1],
-    [1, -1, 1],
-    [-1, 0, 1],
-    [0, 0, 1],
-    [1, 0, 1],
-    [-1, 1, 1],
-    [0, 1, 1],
-    [1, 1, 1],
-];
