@@ -276,17 +276,78 @@ impl FacetGrid {
             return;
         }
         let (a, b) = (self.coords(&lo), self.coords(&hi));
+        // Row by row along x: a row's cells are one run of the cell order (cell by
+        // cell, each cell's lookup cost more than its few facets).
         for z in a[2]..=b[2] {
             for y in a[1]..=b[1] {
-                for x in a[0]..=b[0] {
-                    let c = (z * self.dims[1] + y) * self.dims[0] + x;
-                    out.extend_from_slice(
-                        &self.facets[self.starts[c] as usize..self.starts[c + 1] as usize],
-                    );
-                }
+                let row = (z * self.dims[1] + y) * self.dims[0];
+                let (first, end) = (self.starts[row + a[0]], self.starts[row + b[0] + 1]);
+                out.extend_from_slice(&self.facets[first as usize..end as usize]);
             }
         }
         out.sort_unstable();
         out.dedup();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use rand::{Rng, SeedableRng};
+    use rand_pcg::Pcg64;
+
+    use super::*;
+
+    /// A query returns, sorted and once each, every facet whose box meets the
+    /// ball's box, and no facet whose box lies more than a cell from it (the grid's
+    /// resolution).
+    #[test]
+    fn a_query_finds_the_facets_whose_boxes_meet_the_balls() {
+        let mut rng = Pcg64::seed_from_u64(3);
+        let mut point =
+            |scale: Real| Point3::from(Vector3::from_fn(|_, _| rng.random_range(0.0..scale)));
+        // Small facets scattered in a 1 m box, and a few large ones across it.
+        let mut vertices = Vec::new();
+        let mut triangles = Vec::new();
+        for k in 0..300 {
+            let size = if k % 50 == 0 { 0.8 } else { 0.03 };
+            let a = point(1.0);
+            let (b, c) = (a + point(size).coords, a + point(size).coords);
+            let first = vertices.len() as u32;
+            vertices.extend([a, b, c]);
+            triangles.push([first, first + 1, first + 2]);
+        }
+        let grid = FacetGrid::new(&vertices, &triangles, 0.02);
+        let boxes: Vec<(Vector3<Real>, Vector3<Real>)> = triangles
+            .iter()
+            .map(|t| {
+                let p = t.map(|v| vertices[v as usize].coords);
+                (p[0].inf(&p[1]).inf(&p[2]), p[0].sup(&p[1]).sup(&p[2]))
+            })
+            .collect();
+        let apart = |(lo, hi): &(Vector3<Real>, Vector3<Real>), c: &Vector3<Real>, r: Real| {
+            (0..3).any(|k| hi[k] < c[k] - r || lo[k] > c[k] + r)
+        };
+        let mut found = Vec::new();
+        let mut met = 0;
+        for _ in 0..500 {
+            let centre = point(1.1).coords - Vector3::repeat(0.05);
+            let radius = 0.007;
+            grid.query(&Point3::from(centre), radius, &mut found);
+            assert!(found.windows(2).all(|w| w[0] < w[1]), "sorted, once each");
+            for (f, b) in boxes.iter().enumerate() {
+                if !apart(b, &centre, radius) {
+                    met += 1;
+                    assert!(found.contains(&(f as u32)), "facet {f} at {centre:?}");
+                }
+            }
+            for &f in &found {
+                let b = &boxes[f as usize];
+                assert!(
+                    !apart(b, &centre, radius + grid.cell()),
+                    "facet {f} too far"
+                );
+            }
+        }
+        assert!(met > 100, "the balls meet facets ({met})");
     }
 }
