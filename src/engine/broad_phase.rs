@@ -7,8 +7,8 @@
 //! written to one flat array: the particles, in cell order, each look through half
 //! the 27-cell stencil about them (every pair of neighbouring cells is searched from
 //! one side only; the cells read as runs along x), in parallel over runs of
-//! particles whose pairs are appended in
-//! order, so the output order does not depend on the number of threads.
+//! particles whose pairs are appended in order, so the output order does not
+//! depend on the number of threads.
 //!
 //! # Wide size distributions
 //! One grid sized for the largest particle would put hundreds of small ones in a cell
